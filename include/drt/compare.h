@@ -1,0 +1,21 @@
+// Image comparison for regression tests: error measures and a false-colour difference image.
+#pragma once
+
+#include "drt/image.h"
+
+namespace drt {
+
+struct Comparison {
+    double rmse = 0;  // over all pixels and channels of the stored values
+    double psnr = 0;  // 20 log10(1 / rmse), infinite for equal images
+    double ssim = 1;  // mean structural similarity of the luminance, 1 for equal images
+    double max_abs = 0;  // largest absolute channel difference
+};
+
+// Throws ImageError when the sizes differ.
+Comparison compare_images(const Image& a, const Image& b);
+
+// Per-pixel error as a false-colour image (black = equal, through blue and green to red = large).
+Image difference_image(const Image& a, const Image& b);
+
+}  // namespace drt

@@ -1,0 +1,51 @@
+// In-memory images and the image files drt reads and writes.
+#pragma once
+
+#include <filesystem>
+#include <stdexcept>
+#include <vector>
+
+#include "drt/color.h"
+
+namespace drt {
+
+// Linear RGB floats, row 0 at the top.
+struct Image {
+    int width = 0;
+    int height = 0;
+    std::vector<float> rgb;  // 3 * width * height
+
+    Image() = default;
+    Image(int w, int h) : width(w), height(h), rgb(static_cast<std::size_t>(3) * w * h, 0.0f) {}
+    Color at(int x, int y) const {
+        const std::size_t i = 3 * (static_cast<std::size_t>(y) * width + x);
+        return {rgb[i], rgb[i + 1], rgb[i + 2]};
+    }
+    void set(int x, int y, const Color& c) {
+        const std::size_t i = 3 * (static_cast<std::size_t>(y) * width + x);
+        rgb[i] = static_cast<float>(c.r), rgb[i + 1] = static_cast<float>(c.g), rgb[i + 2] = static_cast<float>(c.b);
+    }
+};
+
+enum class ImageFormat { kPng, kBmp, kPfm };
+
+// A file that cannot be read, written or understood; the message names the file.
+class ImageError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+// The format named by the path's extension (case-insensitive); throws ImageError otherwise.
+ImageFormat format_for_path(const std::filesystem::path& path);
+
+// sRGB transfer curve of a linear value clamped to [0, 1], rounded to 8 bits.
+unsigned char encode_srgb8(double linear);
+
+// Writes .png/.bmp (8-bit sRGB-encoded) or .pfm (linear float). The file appears complete or
+// not at all: data goes to a temporary file in the same folder, which is then renamed.
+void write_image(const Image& image, const std::filesystem::path& path);
+
+// Reads .png/.bmp as stored values / 255 (still sRGB-encoded) and .pfm as its floats.
+Image read_image(const std::filesystem::path& path);
+
+}  // namespace drt

@@ -1,0 +1,74 @@
+// Lights: spheres of uniform radiance (the thesis's round lights) and their limit, the point light.
+#pragma once
+
+#include <optional>
+
+#include "drt/color.h"
+#include "drt/math.h"
+#include "drt/ray.h"
+
+namespace drt {
+
+// A direction to shadow-test from a shading point, and how far the light lies along it.
+struct LightSample {
+    Vec3 dir;  // unit, from the shading point towards the light
+    double distance;
+};
+
+class Light {
+public:
+    explicit Light(Color intensity, bool visible) : intensity_(intensity), visible_(visible) {}
+    virtual ~Light() = default;
+
+    // A direction towards the light from `x`, from a uniform point `u` of the unit square.
+    // Light reaching x is intensity() * max(0, N·dir) * visibility, averaged over such samples:
+    // that is the contract's I·(1/Ω)∫cap max(0, N·ω) V dω, estimated with pdf 1/Ω.
+    virtual LightSample sample(const Vec3& x, Vec2 u) const = 0;
+    // A point light needs exactly one shadow ray; an area light's penumbra needs many.
+    virtual bool is_point() const = 0;
+    // Distance along `ray` at which it enters the light, for lights visible to rays.
+    virtual std::optional<double> intersect(const Ray& ray, Interval range) const = 0;
+
+    const Color& intensity() const { return intensity_; }
+    bool visible() const { return visible_; }
+    // What Cook shares shadow rays by.
+    double power() const { return luminance(intensity_); }
+
+private:
+    Color intensity_;
+    bool visible_;
+};
+
+class PointLight final : public Light {
+public:
+    PointLight(Vec3 position, Color intensity) : Light(intensity, false), position_(position) {}
+    LightSample sample(const Vec3& x, Vec2 u) const override;
+    bool is_point() const override { return true; }
+    std::optional<double> intersect(const Ray&, Interval) const override { return std::nullopt; }
+
+private:
+    Vec3 position_;
+};
+
+class SphereLight final : public Light {
+public:
+    SphereLight(Vec3 centre, double radius, Color intensity, bool visible)
+        : Light(intensity, visible), centre_(centre), radius_(radius) {}
+    // Uniform over the cone of directions the sphere subtends from x; from inside or on the
+    // sphere, where that cone is ill-defined, uniform over all directions.
+    LightSample sample(const Vec3& x, Vec2 u) const override;
+    bool is_point() const override { return false; }
+    std::optional<double> intersect(const Ray& ray, Interval range) const override;
+
+    const Vec3& centre() const { return centre_; }
+    double radius() const { return radius_; }
+
+private:
+    Vec3 centre_;
+    double radius_;
+};
+
+// Uniformly distributed direction in the cone of half-angle acos(cos_max) about +z.
+Vec3 sample_cone(Vec2 u, double cos_max);
+
+}  // namespace drt

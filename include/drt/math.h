@@ -1,0 +1,103 @@
+// Plain value types for geometry: Vec2, Vec3, Interval, Bounds.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace drt {
+
+inline constexpr double kPi = 3.14159265358979323846;
+inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+struct Vec2 {
+    double x = 0, y = 0;
+};
+
+struct Vec3 {
+    double x = 0, y = 0, z = 0;
+
+    constexpr double operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
+    constexpr Vec3 operator-() const { return {-x, -y, -z}; }
+    constexpr Vec3& operator+=(const Vec3& v) {
+        x += v.x, y += v.y, z += v.z;
+        return *this;
+    }
+    constexpr Vec3& operator-=(const Vec3& v) {
+        x -= v.x, y -= v.y, z -= v.z;
+        return *this;
+    }
+    constexpr Vec3& operator*=(double s) {
+        x *= s, y *= s, z *= s;
+        return *this;
+    }
+    friend constexpr bool operator==(const Vec3&, const Vec3&) = default;
+};
+
+constexpr Vec3 operator+(Vec3 a, const Vec3& b) { return a += b; }
+constexpr Vec3 operator-(Vec3 a, const Vec3& b) { return a -= b; }
+constexpr Vec3 operator*(Vec3 a, double s) { return a *= s; }
+constexpr Vec3 operator*(double s, Vec3 a) { return a *= s; }
+constexpr Vec3 operator/(const Vec3& a, double s) { return a * (1.0 / s); }
+constexpr double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+constexpr Vec3 cross(const Vec3& a, const Vec3& b) {
+    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline double length(const Vec3& v) { return std::sqrt(dot(v, v)); }
+inline Vec3 normalize(const Vec3& v) { return v / length(v); }
+constexpr Vec3 min(const Vec3& a, const Vec3& b) {
+    return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)};
+}
+constexpr Vec3 max(const Vec3& a, const Vec3& b) {
+    return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)};
+}
+constexpr Vec3 lerp(const Vec3& a, const Vec3& b, double t) { return a + (b - a) * t; }
+inline double max_abs_component(const Vec3& v) {
+    return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+}
+
+// Mirror direction of d about the normal n (both unit length).
+constexpr Vec3 reflect(const Vec3& d, const Vec3& n) { return d - n * (2.0 * dot(d, n)); }
+
+// An orthonormal basis around a unit vector, continuous except at one pole (Duff et al. 2017).
+struct Frame {
+    Vec3 t, b, n;
+    static Frame around(const Vec3& n) {
+        const double sign = std::copysign(1.0, n.z);
+        const double a = -1.0 / (sign + n.z);
+        const double k = n.x * n.y * a;
+        return {{1.0 + sign * n.x * n.x * a, sign * k, -sign * n.x}, {k, sign + n.y * n.y * a, -n.y}, n};
+    }
+    constexpr Vec3 to_world(const Vec3& v) const { return t * v.x + b * v.y + n * v.z; }
+};
+
+struct Interval {
+    double min = 0, max = kInfinity;
+    constexpr bool contains(double v) const { return min <= v && v <= max; }
+    constexpr bool surrounds(double v) const { return min < v && v < max; }
+};
+
+// Axis-aligned box; the default is empty so that union-growing works from it.
+struct Bounds {
+    Vec3 lo{kInfinity, kInfinity, kInfinity};
+    Vec3 hi{-kInfinity, -kInfinity, -kInfinity};
+
+    constexpr bool empty() const { return lo.x > hi.x; }
+    constexpr Bounds& grow(const Vec3& p) {
+        lo = min(lo, p), hi = max(hi, p);
+        return *this;
+    }
+    constexpr Bounds& grow(const Bounds& b) {
+        lo = min(lo, b.lo), hi = max(hi, b.hi);
+        return *this;
+    }
+    constexpr Vec3 centre() const { return (lo + hi) * 0.5; }
+    constexpr Vec3 extent() const { return hi - lo; }
+    constexpr double surface_area() const {
+        if (empty()) return 0;
+        const Vec3 e = extent();
+        return 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
+    }
+};
+
+}  // namespace drt

@@ -1,0 +1,30 @@
+// Reads the thesis's XML scene format (../shared/spec/scene-format.md) into a Scene.
+#pragma once
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "drt/scene.h"
+
+namespace drt {
+
+// A scene that cannot be rendered. what() is the whole message: "FILE:LINE: Element: message".
+class SceneError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+struct LoadedScene {
+    Scene scene;
+    // "FILE:LINE: warning: ..." for every unknown element or attribute, naming the nearest known one.
+    std::vector<std::string> warnings;
+};
+
+LoadedScene load_scene(const std::filesystem::path& path);
+// `name` stands for the file in messages.
+LoadedScene load_scene_from_string(std::string_view xml, const std::string& name);
+
+}  // namespace drt

@@ -1,0 +1,69 @@
+#include "drt/sampler.h"
+
+#include <cmath>
+
+#include "drt/rng.h"
+
+namespace drt {
+
+namespace {
+
+std::uint32_t key32(std::uint64_t h) { return static_cast<std::uint32_t>(h ^ (h >> 32)); }
+
+}  // namespace
+
+double IndependentSampler::get_1d(const PixelSample& s, std::uint32_t dim) const {
+    return to_unit(hash_of(s.seed, s.pixel, s.index, dim));
+}
+
+Vec2 IndependentSampler::get_2d(const PixelSample& s, std::uint32_t dim) const {
+    const std::uint64_t h = hash_of(s.seed, s.pixel, s.index, dim);
+    return {to_unit(h), to_unit(mix64(h))};
+}
+
+Vec2 IndependentSampler::get_2d_in_set(const PixelSample& s, std::uint32_t dim, std::uint32_t j,
+                                       std::uint32_t) const {
+    const std::uint64_t h = hash_of(s.seed, s.pixel, s.index, dim, j);
+    return {to_unit(h), to_unit(mix64(h))};
+}
+
+Vec2 multi_jittered(std::uint32_t j, std::uint32_t k, std::uint32_t key) {
+    // An m x n grid of cells with m*n >= k, as square as possible; each point sits in its own
+    // cell, in its own column of the fine n-by-m sub-grid and its own row, so every 1-D
+    // projection is stratified into k' = m*n strata as well.
+    const auto m = static_cast<std::uint32_t>(std::max(1.0, std::floor(std::sqrt(double(k)))));
+    const std::uint32_t n = (k + m - 1) / m;
+    const std::uint32_t s = permute(j, k, key * 0x51633e2du);
+    const std::uint32_t col = s % m;
+    const std::uint32_t row = s / m;
+    const std::uint32_t sx = permute(col, m, key * 0x68bc21ebu);
+    const std::uint32_t sy = permute(row, n, key * 0x02e5be93u);
+    const double jx = to_unit(hash_of(key, s, 1));
+    const double jy = to_unit(hash_of(key, s, 2));
+    return {(col + (sy + jx) / n) / m, (row + (sx + jy) / m) / n};
+}
+
+double StratifiedSampler::get_1d(const PixelSample& s, std::uint32_t dim) const {
+    const std::uint32_t key = key32(hash_of(s.seed, s.pixel, dim));
+    const double jitter = to_unit(hash_of(s.seed, s.pixel, s.index, dim));
+    return (permute(s.index, s.count, key) + jitter) / s.count;
+}
+
+Vec2 StratifiedSampler::get_2d(const PixelSample& s, std::uint32_t dim) const {
+    return multi_jittered(s.index, s.count, key32(hash_of(s.seed, s.pixel, dim)));
+}
+
+Vec2 StratifiedSampler::get_2d_in_set(const PixelSample& s, std::uint32_t dim, std::uint32_t j,
+                                      std::uint32_t k) const {
+    return multi_jittered(j, k, key32(hash_of(s.seed, s.pixel, s.index, dim)));
+}
+
+std::unique_ptr<Sampler> make_sampler(std::string_view name) {
+    if (name == "random") return std::make_unique<IndependentSampler>();
+    if (name == "stratified") return std::make_unique<StratifiedSampler>();
+    return nullptr;
+}
+
+std::vector<std::string> sampler_names() { return {"random", "stratified"}; }
+
+}  // namespace drt
