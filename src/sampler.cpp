@@ -12,18 +12,24 @@ std::uint32_t key32(std::uint64_t h) { return static_cast<std::uint32_t>(h ^ (h 
 
 }  // namespace
 
+PixelSample PixelSample::branch(std::uint64_t kind, std::uint64_t j) const {
+    PixelSample child = *this;
+    child.path = hash_of(path, kind, j);
+    return child;
+}
+
 double IndependentSampler::get_1d(const PixelSample& s, std::uint32_t dim) const {
-    return to_unit(hash_of(s.seed, s.pixel, s.index, dim));
+    return to_unit(hash_of(s.seed, s.pixel, s.index, dim, s.path));
 }
 
 Vec2 IndependentSampler::get_2d(const PixelSample& s, std::uint32_t dim) const {
-    const std::uint64_t h = hash_of(s.seed, s.pixel, s.index, dim);
+    const std::uint64_t h = hash_of(s.seed, s.pixel, s.index, dim, s.path);
     return {to_unit(h), to_unit(mix64(h))};
 }
 
 Vec2 IndependentSampler::get_2d_in_set(const PixelSample& s, std::uint32_t dim, std::uint32_t j,
                                        std::uint32_t) const {
-    const std::uint64_t h = hash_of(s.seed, s.pixel, s.index, dim, j);
+    const std::uint64_t h = hash_of(s.seed, s.pixel, s.index, dim, s.path, j);
     return {to_unit(h), to_unit(mix64(h))};
 }
 
@@ -44,18 +50,18 @@ Vec2 multi_jittered(std::uint32_t j, std::uint32_t k, std::uint32_t key) {
 }
 
 double StratifiedSampler::get_1d(const PixelSample& s, std::uint32_t dim) const {
-    const std::uint32_t key = key32(hash_of(s.seed, s.pixel, dim));
-    const double jitter = to_unit(hash_of(s.seed, s.pixel, s.index, dim));
+    const std::uint32_t key = key32(hash_of(s.seed, s.pixel, dim, s.path));
+    const double jitter = to_unit(hash_of(s.seed, s.pixel, s.index, dim, s.path));
     return (permute(s.index, s.count, key) + jitter) / s.count;
 }
 
 Vec2 StratifiedSampler::get_2d(const PixelSample& s, std::uint32_t dim) const {
-    return multi_jittered(s.index, s.count, key32(hash_of(s.seed, s.pixel, dim)));
+    return multi_jittered(s.index, s.count, key32(hash_of(s.seed, s.pixel, dim, s.path)));
 }
 
 Vec2 StratifiedSampler::get_2d_in_set(const PixelSample& s, std::uint32_t dim, std::uint32_t j,
                                       std::uint32_t k) const {
-    return multi_jittered(j, k, key32(hash_of(s.seed, s.pixel, s.index, dim)));
+    return multi_jittered(j, k, key32(hash_of(s.seed, s.pixel, s.index, dim, s.path)));
 }
 
 std::unique_ptr<Sampler> make_sampler(std::string_view name) {

@@ -22,6 +22,11 @@ struct PixelSample {
     std::uint32_t pixel = 0;  // y * width + x
     std::uint32_t index = 0;  // which camera sample of the pixel, 0 .. count-1
     std::uint32_t count = 1;  // camera samples the pixel takes
+    // Which branch of the ray tree is asking (0 for the camera ray's first hit): rays spawned
+    // side by side, such as the glossy rays of one hit, must not reuse each other's numbers.
+    std::uint64_t path = 0;
+
+    PixelSample branch(std::uint64_t kind, std::uint64_t j) const;
 };
 
 namespace dim {
@@ -34,9 +39,14 @@ inline constexpr std::uint32_t kLight = 0;
 inline constexpr std::uint32_t kLightPick = 1;
 inline constexpr std::uint32_t kGlossReflect = 2;
 inline constexpr std::uint32_t kGlossRefract = 3;
-inline constexpr std::uint32_t kPerBounce = 4;
+inline constexpr std::uint32_t kGlassReflect = 4;
+inline constexpr std::uint32_t kPerBounce = 5;
 constexpr std::uint32_t bounce(int depth, std::uint32_t kind) {
     return 16 + static_cast<std::uint32_t>(depth) * kPerBounce + kind;
+}
+// Each area light has its own light dimension, so lights are sampled independently.
+constexpr std::uint32_t light(int depth, std::size_t light_index) {
+    return bounce(depth, kLight) + (static_cast<std::uint32_t>(light_index) << 16);
 }
 }  // namespace dim
 

@@ -1,0 +1,196 @@
+#include "drt/integrator.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "drt/rng.h"
+
+namespace drt {
+
+namespace {
+
+// Attempts at drawing a perturbed direction on the right side of a surface before falling back
+// to the ideal one; at grazing incidence about half the draws land on the wrong side, so the
+// fallback is taken with probability about 2^-32.
+constexpr int kRedrawAttempts = 32;
+
+}  // namespace
+
+Ray spawn_ray(const Vec3& point, const Vec3& normal, const Vec3& dir, double time) {
+    const double offset = max_abs_component(point) * 0x1.0p-32 + 1e-9;
+    const Vec3 towards = dot(dir, normal) >= 0 ? normal : -normal;
+    return {point + towards * offset, dir, time};
+}
+
+Vec3 perturb_direction(const Vec3& ideal, double sigma, Vec2 u) {
+    // Box-Muller radius: the length of a 2-D normal vector with per-axis deviation sigma.
+    const double theta = sigma * std::sqrt(-2.0 * std::log1p(-u.x));
+    const double phi = 2.0 * kPi * u.y;
+    const double sin_t = std::sin(theta);
+    const Vec3 local{sin_t * std::cos(phi), sin_t * std::sin(phi), std::cos(theta)};
+    return normalize(Frame::around(ideal).to_world(local));
+}
+
+Integrator::Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bvh,
+                       const Sampler& sampler)
+    : scene_(scene), plan_(plan), bvh_(bvh), sampler_(sampler), camera_(scene.camera()) {
+    for (const auto& light : scene.lights) {
+        any_visible_light_ = any_visible_light_ || light->visible();
+        if (!light->is_point()) area_lights_.push_back(light.get());
+    }
+}
+
+Color Integrator::sample_pixel(int x, int y, const PixelSample& s, RayCounts& counts) const {
+    const Effects& e = plan_.effects;
+    Vec2 film{x + 0.5, y + 0.5};
+    if (e.antialiasing) {
+        const Vec2 u = sampler_.get_2d(s, dim::kPixel);
+        film = {x + u.x, y + u.y};
+    }
+    const Vec2 lens = e.depth_of_field ? sampler_.get_2d(s, dim::kLens) : Vec2{0.5, 0.5};
+    const double time = e.motion_blur ? sampler_.get_1d(s, dim::kTime) * plan_.shutter_end : 0.0;
+    ++counts.camera;
+    return radiance(camera_.generate_ray(film, lens, time), s, 0, counts);
+}
+
+Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth,
+                           RayCounts& counts) const {
+    const auto hit = bvh_.intersect(ray, {0, kInfinity});
+    if (any_visible_light_) {
+        double nearest = hit ? hit->t : kInfinity;
+        const Light* seen = nullptr;
+        for (const auto& light : scene_.lights) {
+            if (!light->visible()) continue;
+            if (auto t = light->intersect(ray, {0, nearest})) nearest = *t, seen = light.get();
+        }
+        if (seen) return seen->intensity();
+    }
+    if (!hit) return scene_.background;
+
+    const Material& m = hit->object->material();
+    const SurfaceHit surface = hit->object->surface_at(ray, hit->t);
+    // Face both normals towards the incoming ray: planes are two-sided, and a ray inside a
+    // sphere sees its inner side.
+    const bool outside = dot(ray.dir, surface.normal) < 0;
+    const Vec3 geometric = outside ? surface.normal : -surface.normal;
+    Vec3 shading = outside ? surface.shading_normal : -surface.shading_normal;
+    if (dot(shading, ray.dir) >= 0) shading = geometric;  // bump tilted it past the viewer
+
+    Color result;
+    if (m.has_diffuse()) {
+        const Color light =
+            scene_.ambient + direct_light(surface.point, geometric, shading, ray.time, s, depth, counts);
+        result += m.diffuse * surface.kd * light;
+    }
+    if (depth >= scene_.settings.max_depth) return result;  // deeper rays would contribute black
+
+    const double sigma = m.sigma();
+    if (m.reflects()) {
+        const Vec3 ideal = reflect(ray.dir, shading);
+        result += m.reflective * m.ks *
+                  scattered(surface.point, geometric, ideal, sigma, +1, ray.time, s, depth,
+                            dim::kGlossReflect, false, counts);
+    }
+    if (m.transmits()) {
+        // The medium outside every object is air (index 1), as in the thesis.
+        const double eta = outside ? 1.0 / m.index : m.index;
+        const double cos_i = std::max(0.0, -dot(ray.dir, shading));
+        const double fresnel = fresnel_dielectric(cos_i, eta);
+        Color glass;
+        if (fresnel > 0) {
+            glass += fresnel * scattered(surface.point, geometric, reflect(ray.dir, shading), sigma,
+                                         +1, ray.time, s, depth, dim::kGlassReflect, false, counts);
+        }
+        if (fresnel < 1) {
+            auto through = refract(ray.dir, shading, eta);
+            if (!through || dot(*through, geometric) >= 0) through = refract(ray.dir, geometric, eta);
+            if (through) {
+                glass += (1.0 - fresnel) * scattered(surface.point, geometric, *through, sigma, -1,
+                                                     ray.time, s, depth, dim::kGlossRefract, true,
+                                                     counts);
+            }
+        }
+        result += m.transmit * m.kt * glass;
+    }
+    return result;
+}
+
+Color Integrator::scattered(const Vec3& point, const Vec3& geometric, const Vec3& ideal,
+                            double sigma, double side, double time, const PixelSample& s,
+                            int depth, std::uint32_t kind, bool refraction,
+                            RayCounts& counts) const {
+    const std::uint32_t dimension = dim::bounce(depth, kind);
+    const int rays = sigma > 0 && depth == 0 ? scene_.settings.glossy_rays : 1;
+    Color sum;
+    for (int j = 0; j < rays; ++j) {
+        Vec3 dir = ideal;
+        if (sigma > 0) {
+            Vec2 u = rays == 1 ? sampler_.get_2d(s, dimension)
+                               : sampler_.get_2d_in_set(s, dimension, j, rays);
+            for (int attempt = 1;; ++attempt) {
+                dir = perturb_direction(ideal, sigma, u);
+                if (side * dot(dir, geometric) > 0) break;
+                if (attempt == kRedrawAttempts) {
+                    dir = ideal;
+                    break;
+                }
+                const std::uint64_t h = hash_of(s.seed, s.pixel, s.index, dimension, s.path, j, attempt);
+                u = {to_unit(h), to_unit(mix64(h))};
+            }
+        }
+        ++(refraction ? counts.refraction : counts.reflection);
+        sum += radiance(spawn_ray(point, geometric, dir, time), s.branch(kind, j), depth + 1, counts);
+    }
+    return rays == 1 ? sum : sum / rays;
+}
+
+Color Integrator::light_ray(const Light& light, const Vec3& point, const Vec3& geometric,
+                            const Vec3& shading, double time, Vec2 u, RayCounts& counts) const {
+    const LightSample ls = light.sample(point, u);
+    const double cosine = dot(shading, ls.dir);
+    // Light from behind the shading normal or below the surface itself adds nothing; no ray needed.
+    if (cosine <= 0 || dot(geometric, ls.dir) <= 0) return {};
+    ++counts.shadow;
+    const Ray shadow = spawn_ray(point, geometric, ls.dir, time);
+    if (bvh_.occluded(shadow, {0, ls.distance})) return {};
+    return light.intensity() * cosine;
+}
+
+Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const Vec3& shading,
+                               double time, const PixelSample& s, int depth,
+                               RayCounts& counts) const {
+    Color sum;
+    for (std::size_t i = 0; i < scene_.lights.size(); ++i) {
+        const int rays = plan_.shadow_rays[i];
+        if (rays == 0) continue;
+        const Light& light = *scene_.lights[i];
+        const std::uint32_t dimension = dim::light(depth, i);
+        Color light_sum;
+        for (int j = 0; j < rays; ++j) {
+            const Vec2 u = rays == 1 ? sampler_.get_2d(s, dimension)
+                                     : sampler_.get_2d_in_set(s, dimension, j, rays);
+            light_sum += light_ray(light, point, geometric, shading, time, u, counts);
+        }
+        sum += rays == 1 ? light_sum : light_sum / rays;
+    }
+    if (plan_.shared_rays > 0) {
+        // Fewer rays than area lights: each ray picks one in proportion to power (stratified
+        // over the rays), and its contribution is divided by the pick probability.
+        const int rays = plan_.shared_rays;
+        const std::uint32_t dimension = dim::bounce(depth, dim::kLightPick);
+        for (int j = 0; j < rays; ++j) {
+            Vec2 u = rays == 1 ? sampler_.get_2d(s, dimension)
+                               : sampler_.get_2d_in_set(s, dimension, j, rays);
+            const auto& cdf = plan_.light_pick_cdf;
+            const std::size_t k = std::min<std::size_t>(
+                std::upper_bound(cdf.begin(), cdf.end(), u.x) - cdf.begin(), cdf.size() - 1);
+            const double lo = k == 0 ? 0.0 : cdf[k - 1];
+            const double p = cdf[k] - lo;
+            u.x = std::clamp((u.x - lo) / p, 0.0, std::nextafter(1.0, 0.0));  // reuse within the pick
+            sum += light_ray(*area_lights_[k], point, geometric, shading, time, u, counts) / (p * rays);
+        }
+    }
+    return sum;
+}
+
+}  // namespace drt

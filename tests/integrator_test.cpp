@@ -1,0 +1,159 @@
+#include "drt/integrator.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "drt/renderer.h"
+#include "test_scenes.h"
+
+namespace drt {
+namespace {
+
+using testing::floor_scene;
+using testing::lone_sphere_scene;
+
+RenderResult render_with(const Scene& scene, int threads = 2) {
+    RenderOptions options;
+    options.threads = threads;
+    return render(scene, options);
+}
+
+TEST(Integrator, GreyFloorUnderPointLightIsLambertExactly) {
+    Scene scene = floor_scene(24, 16);
+    const Vec3 light{7, 30, -3};
+    const Color intensity{1.0, 0.5, 0.25};
+    scene.lights.push_back(std::make_unique<PointLight>(light, intensity));
+    const RenderResult r = render_with(scene);
+    const Camera camera = scene.camera();
+    for (int y = 0; y < 16; ++y) {
+        for (int x = 0; x < 24; ++x) {
+            const Ray ray = camera.generate_ray({x + 0.5, y + 0.5}, {0.5, 0.5}, 0);
+            const Vec3 p = ray.at(-ray.origin.y / ray.dir.y);
+            const double cosine = normalize(light - p).y;
+            const Color expected = 0.8 * intensity * cosine;
+            const Color got = r.image.at(x, y);
+            ASSERT_NEAR(got.r, expected.r, 1e-6) << x << "," << y;
+            ASSERT_NEAR(got.g, expected.g, 1e-6);
+            ASSERT_NEAR(got.b, expected.b, 1e-6);
+        }
+    }
+}
+
+TEST(Integrator, AmbientAddsToTheLightsInTheDiffusePart) {
+    Scene scene = floor_scene(4, 4);
+    scene.ambient = {0.25, 0.25, 0.25};
+    const RenderResult r = render_with(scene);
+    EXPECT_NEAR(r.image.at(1, 1).r, 0.8 * 0.25, 1e-7);
+}
+
+TEST(Integrator, IdealMirrorOfUniformBackgroundReturnsKsTimesBackground) {
+    const Color background{0.2, 0.4, 0.6};
+    const Color ks{0.5, 0.7, 0.9};
+    const RenderResult r = render_with(lone_sphere_scene(testing::mirror(ks), background));
+    int mirror_pixels = 0;
+    for (int y = 0; y < r.image.height; ++y) {
+        for (int x = 0; x < r.image.width; ++x) {
+            const Color c = r.image.at(x, y);
+            if (c == Color{float(background.r), float(background.g), float(background.b)}) continue;
+            ++mirror_pixels;
+            EXPECT_FLOAT_EQ(c.r, ks.r * background.r);
+            EXPECT_FLOAT_EQ(c.g, ks.g * background.g);
+            EXPECT_FLOAT_EQ(c.b, ks.b * background.b);
+        }
+    }
+    EXPECT_GT(mirror_pixels, 100);
+    EXPECT_EQ(r.stats.rays.reflection, static_cast<std::uint64_t>(mirror_pixels));
+}
+
+TEST(Integrator, GlossyMirrorOfUniformBackgroundConservesEnergy) {
+    const Color background{0.3, 0.3, 0.3};
+    Scene scene = lone_sphere_scene(testing::mirror({0.6, 0.6, 0.6}, 10.0), background);
+    scene.settings.glossy_rays = 4;
+    const RenderResult r = render_with(scene);
+    for (int y = 0; y < r.image.height; ++y) {
+        for (int x = 0; x < r.image.width; ++x) {
+            const double v = r.image.at(x, y).r;
+            // Every perturbed ray escapes a convex mirror, so each pixel is exactly one of two values.
+            ASSERT_TRUE(std::abs(v - 0.3) < 1e-6 || std::abs(v - 0.18) < 1e-6) << v;
+        }
+    }
+}
+
+TEST(Integrator, GlassSphereWithIndexOneVanishesExactly) {
+    const Color background{0.1, 0.5, 0.9};
+    const RenderResult r = render_with(lone_sphere_scene(testing::glass(1.0), background));
+    for (int y = 0; y < r.image.height; ++y) {
+        for (int x = 0; x < r.image.width; ++x) {
+            const Color c = r.image.at(x, y);
+            ASSERT_FLOAT_EQ(c.r, 0.1f);
+            ASSERT_FLOAT_EQ(c.g, 0.5f);
+            ASSERT_FLOAT_EQ(c.b, 0.9f);
+        }
+    }
+}
+
+TEST(Integrator, GlassSphereInUniformBackgroundShowsTheBackground) {
+    const Color background{0.5, 0.5, 0.5};
+    Scene scene = lone_sphere_scene(testing::glass(1.5), background, 48);
+    scene.settings.max_depth = 32;
+    const RenderResult r = render_with(scene);
+    double sum = 0;
+    double worst = 0;
+    for (int y = 0; y < r.image.height; ++y) {
+        for (int x = 0; x < r.image.width; ++x) {
+            sum += r.image.at(x, y).g;
+            worst = std::max(worst, std::abs(r.image.at(x, y).g - 0.5));
+        }
+    }
+    EXPECT_NEAR(sum / (48 * 48), 0.5, 1e-4);
+    EXPECT_LT(worst, 1e-3);  // only chains of internal reflection longer than MaxDepth lose light
+}
+
+TEST(Integrator, MaxDepthZeroMakesMirrorsBlack) {
+    Scene scene = lone_sphere_scene(testing::mirror({1, 1, 1}), {1, 1, 1});
+    scene.settings.max_depth = 0;
+    const RenderResult r = render_with(scene);
+    EXPECT_EQ(r.image.at(16, 16).r, 0.0f);
+    EXPECT_EQ(r.stats.rays.reflection, 0u);
+}
+
+TEST(Integrator, ImageIsIdenticalForOneAndTwoThreads) {
+    Scene scene = floor_scene(40, 30);
+    scene.settings.samples = 4;
+    scene.settings.shadow_rays = 3;
+    scene.lights.push_back(std::make_unique<SphereLight>(Vec3{5, 20, 5}, 6.0, Color{1, 1, 1}, false));
+    const Material& m = testing::add_material(scene, testing::mirror({0.9, 0.9, 0.9}, 20.0));
+    scene.objects.push_back(std::make_unique<Sphere>(std::vector<Vec3>{{0, 5, 0}, {3, 5, 0}}, 5.0, m));
+    const RenderResult one = render_with(scene, 1);
+    const RenderResult two = render_with(scene, 2);
+    EXPECT_EQ(one.image.rgb, two.image.rgb);
+    EXPECT_EQ(one.stats.rays.total(), two.stats.rays.total());
+    scene.settings.seed = 7;
+    EXPECT_NE(render_with(scene, 2).image.rgb, one.image.rgb);
+}
+
+TEST(SpawnRay, LeavesTheSurfaceOnTheSideOfTheDirection) {
+    const Vec3 p{1e5, 0, -1e5};
+    const Ray up = spawn_ray(p, {0, 1, 0}, normalize(Vec3{1, 1e-3, 0}), 0);
+    EXPECT_GT(up.origin.y, 0);
+    const Ray down = spawn_ray(p, {0, 1, 0}, normalize(Vec3{1, -1e-3, 0}), 0);
+    EXPECT_LT(down.origin.y, 0);
+}
+
+TEST(PerturbDirection, AngularSpreadMatchesSigma) {
+    const Vec3 ideal = normalize(Vec3{0.3, 1, -0.2});
+    const double sigma = 0.05;
+    double sum_sq = 0;
+    const int n = 64 * 64;
+    for (int i = 0; i < n; ++i) {
+        const Vec2 u = multi_jittered(i, n, 99);
+        const double angle = std::acos(std::min(1.0, dot(perturb_direction(ideal, sigma, u), ideal)));
+        sum_sq += angle * angle;
+    }
+    // The angle of a 2-D normal offset with per-axis deviation sigma has E[angle^2] = 2 sigma^2.
+    EXPECT_NEAR(sum_sq / n, 2 * sigma * sigma, 0.02 * 2 * sigma * sigma);
+}
+
+}  // namespace
+}  // namespace drt
