@@ -34,19 +34,19 @@ Vec2 IndependentSampler::get_2d_in_set(const PixelSample& s, std::uint32_t dim, 
 }
 
 Vec2 multi_jittered(std::uint32_t j, std::uint32_t k, std::uint32_t key) {
-    // An m x n grid of cells with m*n >= k, as square as possible; each point sits in its own
-    // cell, in its own column of the fine n-by-m sub-grid and its own row, so every 1-D
-    // projection is stratified into k' = m*n strata as well.
+    // Kensler's pattern for any k: an m x n grid of cells, m*n >= k, as square as possible. Point
+    // s (a shuffled j) takes its own stratum of y among k strata, and its own column sx and
+    // sub-column sy of x among m*n; when k = m*n each cell of the grid holds exactly one point.
+    // Which of the m*n sub-columns stay empty when k < m*n is left to the shuffles, so every
+    // point is uniform over the square (a fixed choice would leave a corner unsampled).
     const auto m = static_cast<std::uint32_t>(std::max(1.0, std::floor(std::sqrt(double(k)))));
     const std::uint32_t n = (k + m - 1) / m;
     const std::uint32_t s = permute(j, k, key * 0x51633e2du);
-    const std::uint32_t col = s % m;
-    const std::uint32_t row = s / m;
-    const std::uint32_t sx = permute(col, m, key * 0x68bc21ebu);
-    const std::uint32_t sy = permute(row, n, key * 0x02e5be93u);
+    const std::uint32_t sx = permute(s % m, m, key * 0x68bc21ebu);
+    const std::uint32_t sy = permute(s / m, n, key * 0x02e5be93u);
     const double jx = to_unit(hash_of(key, s, 1));
     const double jy = to_unit(hash_of(key, s, 2));
-    return {(col + (sy + jx) / n) / m, (row + (sx + jy) / m) / n};
+    return {(sx + (sy + jx) / n) / m, (s + jy) / k};
 }
 
 double StratifiedSampler::get_1d(const PixelSample& s, std::uint32_t dim) const {

@@ -1,6 +1,7 @@
 #include "drt/sphere.h"
 
 #include <cmath>
+#include <limits>
 
 namespace drt {
 
@@ -24,7 +25,13 @@ std::optional<double> intersect_sphere(const Vec3& centre, double radius, const 
     const Vec3 closest = oc - ray.dir * b;
     const double disc = radius * radius - dot(closest, closest);
     if (disc < 0) return std::nullopt;
-    const double c = dot(oc, oc) - radius * radius;
+    double c = dot(oc, oc) - radius * radius;
+    // An origin on the sphere up to rounding (a ray leaving a hit point) has its near root at
+    // exactly 0, which a range starting at 0 excludes, rather than a root of either sign ~1e-16
+    // away that would re-hit the sphere going out or stop short of the far side going in.
+    const double on_surface_tolerance = 16.0 * std::numeric_limits<double>::epsilon() * radius *
+                                        (max_abs_component(ray.origin) + radius);
+    if (std::abs(c) <= on_surface_tolerance) c = 0;
     // q has the sign of -b, so no cancellation; the two roots are q and c/q.
     const double q = -b - std::copysign(std::sqrt(disc), b);
     double t0 = q, t1 = q != 0 ? c / q : 0;
@@ -40,7 +47,7 @@ std::optional<double> Sphere::intersect(const Ray& ray, Interval range) const {
 
 std::vector<TimedBounds> Sphere::motion_bounds() const {
     const Vec3 r{radius_, radius_, radius_};
-    if (path_.size() == 1) return {{Bounds{}.grow(path_[0] - r).grow(path_[0] + r), {}}};
+    if (path_.size() == 1) return {{Bounds{}.grow(path_[0] - r).grow(path_[0] + r)}};  // all time
     std::vector<TimedBounds> segments;
     for (std::size_t k = 0; k + 1 < path_.size(); ++k) {
         Bounds b;

@@ -28,27 +28,39 @@ constexpr std::uint64_t hash_of(std::uint64_t first, Ts... rest) {
 // A uniform double in [0, 1) from the top 53 bits of a hash.
 constexpr double to_unit(std::uint64_t h) { return static_cast<double>(h >> 11) * 0x1.0p-53; }
 
-// A pseudo-random permutation of [0, n) evaluated at i, by cycle-walking a keyed bijection on
-// the smallest power-of-two domain that holds n (the idea of Kensler's "Correlated Multi-Jittered
-// Sampling", 2013).
+// A pseudo-random permutation of [0, n) evaluated at i: Kensler's function from "Correlated
+// Multi-Jittered Sampling" (2013), which cycle-walks a keyed bijection on the smallest
+// power-of-two domain that holds n. Each step is invertible on the low bits, and every key bit
+// takes part, so over random keys each element is sent to every position equally often.
 constexpr std::uint32_t permute(std::uint32_t i, std::uint32_t n, std::uint32_t key) {
     if (n <= 1) return 0;
-    std::uint32_t mask = n - 1;
-    mask |= mask >> 1, mask |= mask >> 2, mask |= mask >> 4, mask |= mask >> 8, mask |= mask >> 16;
+    std::uint32_t w = n - 1;
+    w |= w >> 1, w |= w >> 2, w |= w >> 4, w |= w >> 8, w |= w >> 16;
     do {
-        // Each step is invertible on [0, mask]: xor with a constant, multiplication by an odd
-        // number modulo 2^k, and xor with a right shift of itself.
-        i ^= key & mask;
-        i = (i * 0x9e3779b1u) & mask;
-        i ^= (i & mask) >> 3;
-        i ^= (key >> 8) & mask;
-        i = (i * 0x85ebca6bu) & mask;
-        i ^= (i & mask) >> 7;
-        i = (i * 0xc2b2ae35u) & mask;
-        i ^= (key >> 16) & mask;
-        i ^= (i & mask) >> 5;
+        // Xor with a constant, multiplication by an odd number and xor with a right shift of
+        // the masked bits all leave the low bits a bijection of the low bits.
+        i ^= key;
+        i *= 0xe170893du;
+        i ^= key >> 16;
+        i ^= (i & w) >> 4;
+        i ^= key >> 8;
+        i *= 0x0929eb3fu;
+        i ^= key >> 23;
+        i ^= (i & w) >> 1;
+        i *= 1u | key >> 27;
+        i *= 0x6935fa69u;
+        i ^= (i & w) >> 11;
+        i *= 0x74dcb303u;
+        i ^= (i & w) >> 2;
+        i *= 0x9e501cc3u;
+        i ^= (i & w) >> 2;
+        i *= 0xc860a3dfu;
+        i &= w;
+        i ^= i >> 5;
     } while (i >= n);
-    return i;
+    // The rotation by the key, in 64 bits: Kensler's 32-bit (i + key) % n wraps for large keys
+    // and maps two elements to one.
+    return static_cast<std::uint32_t>((std::uint64_t{i} + key) % n);
 }
 
 }  // namespace drt

@@ -76,10 +76,10 @@ public:
                        std::uint32_t k) const override;
 };
 
-// Jittered strata in every dimension: correlated multi-jittered patterns (Kensler 2013) in 2-D,
-// which stratify the square and both of its projections for any sample count, and shuffled
-// jittered strata in 1-D; each dimension's pattern is keyed separately, so dimensions are
-// decorrelated.
+// Jittered strata in every dimension: multi-jittered patterns (after Kensler 2013) in 2-D and
+// shuffled jittered strata in 1-D. A 2-D pattern of k points always stratifies y into k strata;
+// x and the m x n cells of the square are fully stratified only when k = m*n (e.g. square k).
+// Each dimension's pattern is keyed separately, so dimensions are decorrelated.
 class StratifiedSampler final : public Sampler {
 public:
     std::string_view name() const override { return "stratified"; }

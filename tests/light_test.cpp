@@ -1,0 +1,179 @@
+#include "drt/light.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "drt/rng.h"
+#include "drt/sampler.h"
+
+namespace drt {
+namespace {
+
+constexpr Color kWhite{1, 1, 1};
+
+double angle_between(const Vec3& a, const Vec3& b) {
+    return std::atan2(length(cross(a, b)), dot(a, b));
+}
+
+Vec3 unit_vector(std::uint64_t seed, std::uint64_t i) {
+    const double z = 1.0 - 2.0 * to_unit(hash_of(seed, i, 0));
+    const double phi = 2.0 * kPi * to_unit(hash_of(seed, i, 1));
+    const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
+    return {s * std::cos(phi), s * std::sin(phi), z};
+}
+
+// k well-distributed points of the unit square.
+std::vector<Vec2> stratified_square(std::uint32_t k, std::uint32_t key) {
+    std::vector<Vec2> points;
+    for (std::uint32_t j = 0; j < k; ++j) points.push_back(multi_jittered(j, k, key));
+    return points;
+}
+
+TEST(LightPoint, SampleIsTheExactDirectionAndDistance) {
+    const PointLight light({4, 6, 3}, kWhite);
+    EXPECT_TRUE(light.is_point());
+    EXPECT_FALSE(light.visible());
+    for (const Vec2 u : {Vec2{0, 0}, Vec2{0.3, 0.9}, Vec2{0.99, 0.5}}) {
+        const LightSample s = light.sample({1, 2, 3}, u);
+        EXPECT_DOUBLE_EQ(s.distance, 5.0);
+        EXPECT_DOUBLE_EQ(s.dir.x, 0.6);
+        EXPECT_DOUBLE_EQ(s.dir.y, 0.8);
+        EXPECT_EQ(s.dir.z, 0.0);
+    }
+    EXPECT_FALSE(light.intersect({{0, 0, 0}, {0.8, 0.6, 0}}, {}));
+}
+
+TEST(LightSphere, PowerIsTheLuminanceOfTheIntensity) {
+    const SphereLight light({0, 0, 0}, 1, {1, 0, 0}, false);
+    EXPECT_DOUBLE_EQ(light.power(), 0.2126);
+    EXPECT_FALSE(light.is_point());
+}
+
+TEST(LightSphere, SamplesLieInTheSubtendedConeAndLandOnTheSphere) {
+    struct Case {
+        Vec3 centre;
+        double radius;
+        Vec3 x;
+    };
+    const Case cases[] = {
+        {{0, 10, 0}, 1, {0, 0, 0}},       {{300, 450, 300}, 40, {12, 0, -7}},
+        {{0, 0, 0}, 1, {0, 0, 1.0001}},    // almost touching: a nearly hemispherical cone
+        {{5, 5, 5}, 1e-3, {-100, 3, 40}},  // tiny and far
+        {{0, 0, -3}, 2, {0.5, 0.5, 0}},
+    };
+    for (std::size_t k = 0; k < std::size(cases); ++k) {
+        const auto& [c, r, x] = cases[k];
+        const SphereLight light(c, r, kWhite, false);
+        const double d = length(c - x);
+        const double half_angle = std::asin(r / d);
+        double widest = 0;
+        for (const Vec2 u : stratified_square(1024, static_cast<std::uint32_t>(k))) {
+            const LightSample s = light.sample(x, u);
+            ASSERT_NEAR(length(s.dir), 1.0, 1e-14) << k;
+            const double angle = angle_between(s.dir, c - x);
+            EXPECT_LE(angle, half_angle + 1e-12) << k;
+            widest = std::max(widest, angle);
+            // On the near side of the sphere.
+            EXPECT_NEAR(length(x + s.dir * s.distance - c), r, 1e-9 * (r + d)) << k;
+            EXPECT_LE(s.distance, dot(c - x, s.dir) + 1e-9 * d) << k;
+            EXPECT_GT(s.distance, 0) << k;
+        }
+        EXPECT_GT(widest, 0.95 * half_angle) << k;  // and they do fill the cone
+    }
+}
+
+TEST(LightSphere, AverageCosineOverTheCapMatchesTheAnalyticValue) {
+    // Uniform over a cap of half-angle alpha, cos(theta) is uniform on [cos alpha, 1], so
+    // (1/Omega) Int_cap cos(theta) dw = (1 + cos alpha) / 2. A cap tilted by beta from the normal,
+    // still wholly above the horizon, averages N . (mean direction) = cos(beta) (1 + cos alpha)/2.
+    const double r = 40, height = 150;
+    const Vec3 x{3, -2, 1};
+    const SphereLight light(x + Vec3{0, height, 0}, r, kWhite, false);
+    const double cos_alpha = std::sqrt(1 - (r / height) * (r / height));
+    const std::uint32_t k = 4096;
+    for (const double beta : {0.0, 0.3, 1.0}) {
+        const Vec3 normal{std::sin(beta), std::cos(beta), 0};
+        double sum = 0;
+        for (const Vec2 u : stratified_square(k, 7)) {
+            sum += std::max(0.0, dot(normal, light.sample(x, u).dir));
+        }
+        EXPECT_NEAR(sum / k, std::cos(beta) * (1 + cos_alpha) / 2, 1e-4) << beta;
+    }
+    // A small light is a point light: the average is N . L.
+    const SphereLight small(x + Vec3{0, height, 0}, 1e-3, kWhite, false);
+    const Vec3 normal = normalize(Vec3{1, 2, 0});
+    double sum = 0;
+    for (const Vec2 u : stratified_square(256, 3)) sum += dot(normal, small.sample(x, u).dir);
+    EXPECT_NEAR(sum / 256, normal.y, 1e-6);
+}
+
+TEST(LightSphere, ShadingPointInsideOrOnTheSphereGetsFiniteSamples) {
+    const Vec3 c{1, 2, 3};
+    const double r = 2;
+    const SphereLight light(c, r, kWhite, false);
+    const Vec3 inside_points[] = {c, c + Vec3{0.5, -1, 0.3}};
+    for (const Vec3& x : inside_points) {
+        for (const Vec2 u : stratified_square(256, 1)) {
+            const LightSample s = light.sample(x, u);
+            ASSERT_TRUE(std::isfinite(s.dir.x) && std::isfinite(s.dir.y) && std::isfinite(s.dir.z));
+            ASSERT_TRUE(std::isfinite(s.distance));
+            EXPECT_NEAR(length(s.dir), 1.0, 1e-14);
+            EXPECT_GT(s.distance, 0);
+            EXPECT_NEAR(length(x + s.dir * s.distance - c), r, 1e-12);
+        }
+    }
+    // Exactly on the surface, and within rounding of it from outside.
+    const Vec3 on_surface[] = {c + Vec3{0, r, 0}, c + Vec3{0, 0, -r}, c + unit_vector(5, 0) * r,
+                               c + Vec3{r * (1 + 4e-16), 0, 0}};
+    for (const Vec3& x : on_surface) {
+        for (const Vec2 u : stratified_square(256, 2)) {
+            const LightSample s = light.sample(x, u);
+            ASSERT_TRUE(std::isfinite(s.dir.x) && std::isfinite(s.dir.y) && std::isfinite(s.dir.z));
+            ASSERT_TRUE(std::isfinite(s.distance));
+            EXPECT_NEAR(length(s.dir), 1.0, 1e-14);
+            EXPECT_GE(s.distance, 0);
+            EXPECT_LE(s.distance, 2 * r + 1e-12);
+        }
+    }
+}
+
+TEST(LightSphere, IntersectFindsTheSphere) {
+    const SphereLight light({0, 0, 10}, 2, kWhite, true);
+    EXPECT_TRUE(light.visible());
+    const auto t = light.intersect({{0, 0, 0}, {0, 0, 1}}, {});
+    ASSERT_TRUE(t);
+    EXPECT_DOUBLE_EQ(*t, 8.0);
+    EXPECT_FALSE(light.intersect({{0, 0, 0}, {0, 0, 1}}, {0, 7.5}));
+    EXPECT_FALSE(light.intersect({{0, 0, 0}, {0, 1, 0}}, {}));
+}
+
+TEST(LightSampleCone, DirectionsStayInTheConeAndAreUniformInSolidAngle) {
+    for (const double cos_max : {-1.0, 0.0, 0.5, 0.9, 0.999}) {
+        const std::uint32_t k = 4096;
+        double sum_cos = 0, sum_x = 0, sum_y = 0, sum_cos2 = 0;
+        for (const Vec2 u : stratified_square(k, 11)) {
+            const Vec3 w = sample_cone(u, cos_max);
+            ASSERT_NEAR(length(w), 1.0, 1e-14);
+            ASSERT_GE(w.z, cos_max - 1e-15);
+            sum_cos += w.z, sum_cos2 += w.z * w.z;
+            sum_x += w.x, sum_y += w.y;
+        }
+        // Uniform in solid angle: cos(theta) uniform on [cos_max, 1].
+        const double mean = (1 + cos_max) / 2;
+        const double mean_sq = (1 + cos_max + cos_max * cos_max) / 3;
+        EXPECT_NEAR(sum_cos / k, mean, 1e-4) << cos_max;
+        EXPECT_NEAR(sum_cos2 / k, mean_sq, 1e-4) << cos_max;
+        // Symmetric about the axis.
+        EXPECT_NEAR(sum_x / k, 0, 2e-3) << cos_max;
+        EXPECT_NEAR(sum_y / k, 0, 2e-3) << cos_max;
+    }
+    // The rim and the axis.
+    EXPECT_NEAR(sample_cone({1, 0}, 0.5).z, 0.5, 1e-15);
+    EXPECT_EQ(sample_cone({0, 0.3}, 0.5).z, 1.0);
+}
+
+}  // namespace
+}  // namespace drt
