@@ -22,8 +22,8 @@ Camera Camera::look_at(const LookAt& view, int width, int height, Lens lens) {
                   lens);
 }
 
-Camera Camera::thesis_default(int width, int height, Lens lens) {
-    const Vec3 eye{width / 2.0, height / 2.0, -static_cast<double>(width)};
+Camera Camera::thesis_default(int width, int height, Lens lens, double pixel_size) {
+    const Vec3 eye{width * pixel_size / 2, height * pixel_size / 2, -width * pixel_size};
     // The image plane z = 0 lies `width` in front of the eye and is `height` tall.
     const double half_height = 0.5 * height / width;
     return Camera(eye, {0, 0, 1}, {0, 1, 0}, half_height, width, height, lens);

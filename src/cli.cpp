@@ -38,6 +38,7 @@ struct Overrides {
     std::optional<int> spp, shadow_rays, width, height, glossy_rays, max_depth;
     std::optional<std::uint64_t> seed;
     std::optional<std::string> sampler;
+    std::optional<double> scale;
 
     void add_to(CLI::App& app) {
         app.add_option("--spp", spp, "Camera samples per pixel (overrides Render Samples)")
@@ -46,6 +47,10 @@ struct Overrides {
             ->check(CLI::PositiveNumber);
         app.add_option("--width", width, "Overrides Image Width")->check(CLI::PositiveNumber);
         app.add_option("--height", height, "Overrides Image Height")->check(CLI::PositiveNumber);
+        app.add_option("--scale", scale,
+                       "Multiplies the image size, keeping the framing (applied after --width and "
+                       "--height)")
+            ->check(CLI::PositiveNumber);
         app.add_option("--seed", seed, "Overrides Render Seed");
         app.add_option("--glossy-rays", glossy_rays, "Overrides Render GlossyRays")
             ->check(CLI::PositiveNumber);
@@ -60,6 +65,11 @@ struct Overrides {
         if (shadow_rays) s.shadow_rays = *shadow_rays;
         if (width) s.width = *width;
         if (height) s.height = *height;
+        if (scale) {
+            s.width = std::max(1, static_cast<int>(std::lround(s.width * *scale)));
+            s.height = std::max(1, static_cast<int>(std::lround(s.height * *scale)));
+            s.pixel_plane_unit /= *scale;
+        }
         if (seed) s.seed = *seed;
         if (glossy_rays) s.glossy_rays = *glossy_rays;
         if (max_depth) s.max_depth = *max_depth;

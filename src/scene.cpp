@@ -7,7 +7,7 @@ namespace drt {
 
 Camera Scene::camera() const {
     if (view) return Camera::look_at(*view, settings.width, settings.height, lens);
-    return Camera::thesis_default(settings.width, settings.height, lens);
+    return Camera::thesis_default(settings.width, settings.height, lens, settings.pixel_plane_unit);
 }
 
 double Scene::shutter_end() const {

@@ -25,8 +25,9 @@ class Camera {
 public:
     static Camera look_at(const LookAt& view, int width, int height, Lens lens);
     // The thesis's pixel-plane camera: pixel (i, j) at world (i + ½, height − j − ½, 0), the eye
-    // at (width/2, height/2, −width), looking along +z with y up.
-    static Camera thesis_default(int width, int height, Lens lens);
+    // at (width/2, height/2, −width), looking along +z with y up. `pixel_size` ≠ 1 scales that
+    // world geometry, so a resized render (drt --scale) keeps the scene's framing.
+    static Camera thesis_default(int width, int height, Lens lens, double pixel_size = 1);
 
     // The ray through film position `film` (pixel units, x right, y down, pixel (i, j) covering
     // [i, i+1] x [j, j+1]); `lens_u` picks the lens point and is ignored by a pinhole.

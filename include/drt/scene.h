@@ -25,6 +25,9 @@ struct RenderSettings {
     int glossy_rays = 1;   // rays per glossy reflection/refraction at the first hit
     std::uint64_t seed = 0;
     std::string sampler = "stratified";
+    // World units per pixel of the thesis's pixel-plane camera: 1 as the scene format defines
+    // it; drt --scale changes it so a smaller or larger image keeps the same framing.
+    double pixel_plane_unit = 1;
 };
 
 struct Scene {
