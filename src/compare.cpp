@@ -101,7 +101,8 @@ double srgb_to_linear(double v) {
     return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
 }
 
-// Display colour for t in [0, 1]: black, blue, green, yellow, red at equal steps.
+}  // namespace
+
 Color false_colour(double t) {
     static constexpr std::array<Color, 5> kStops{
         {{0, 0, 0}, {0, 0, 1}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}}};
@@ -111,19 +112,21 @@ Color false_colour(double t) {
     return {srgb_to_linear(c.r), srgb_to_linear(c.g), srgb_to_linear(c.b)};
 }
 
-}  // namespace
-
 Comparison compare_images(const Image& a, const Image& b) {
     require_same_size(a, b);
     Comparison result;
     if (a.rgb.empty()) return result;
 
     double sum = 0;
+    bool any_nan = false;
     for (std::size_t i = 0; i < a.rgb.size(); ++i) {
         const double d = static_cast<double>(a.rgb[i]) - b.rgb[i];
         sum += d * d;
         result.max_abs = std::max(result.max_abs, std::abs(d));
+        any_nan = any_nan || std::isnan(d);
+        result.nonfinite += !std::isfinite(a.rgb[i]) || !std::isfinite(b.rgb[i]);
     }
+    if (any_nan) result.max_abs = std::numeric_limits<double>::quiet_NaN();
     result.rmse = std::sqrt(sum / a.rgb.size());
     result.psnr = result.rmse == 0 ? std::numeric_limits<double>::infinity()
                                    : 20 * std::log10(1 / result.rmse);

@@ -1,0 +1,744 @@
+// The `drt` command line as outside users drive it (../shared/spec/cli.md): every test runs the
+// built binary in a fresh folder and checks exit status, messages and the files left behind.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <pty.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <map>
+#include <memory>
+#include <regex>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "drt/image.h"
+
+namespace drt {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string read_bytes(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void write_bytes(const fs::path& path, const std::string& bytes) {
+    std::ofstream(path, std::ios::binary) << bytes;
+}
+
+struct Outcome {
+    int status = -1;
+    std::string out, err;
+};
+
+// Runs the drt binary with `args` in `cwd`, stdout and stderr captured through files (no pipe to
+// fill up), stdin closed.
+Outcome run_drt(const std::vector<std::string>& args, const fs::path& cwd) {
+    const fs::path out_file = cwd / ".drt_stdout", err_file = cwd / ".drt_stderr";
+    const pid_t pid = fork();
+    if (pid == 0) {
+        const int in = open("/dev/null", O_RDONLY);
+        const int out = open(out_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        const int err = open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (in < 0 || out < 0 || err < 0 || chdir(cwd.c_str()) != 0) _exit(127);
+        dup2(in, 0), dup2(out, 1), dup2(err, 2);
+        std::vector<char*> argv{const_cast<char*>(DRT_BINARY)};
+        for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        execv(DRT_BINARY, argv.data());
+        _exit(127);
+    }
+    int wstatus = 0;
+    waitpid(pid, &wstatus, 0);
+    Outcome r;
+    r.status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1;
+    r.out = read_bytes(out_file);
+    r.err = read_bytes(err_file);
+    fs::remove(out_file);
+    fs::remove(err_file);
+    return r;
+}
+
+// Runs drt with stdout and stderr on a pseudo-terminal and returns what the terminal showed.
+std::string run_drt_on_terminal(const std::vector<std::string>& args, const fs::path& cwd) {
+    int master = -1;
+    const pid_t pid = forkpty(&master, nullptr, nullptr, nullptr);
+    if (pid == 0) {
+        if (chdir(cwd.c_str()) != 0) _exit(127);
+        std::vector<char*> argv{const_cast<char*>(DRT_BINARY)};
+        for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        execv(DRT_BINARY, argv.data());
+        _exit(127);
+    }
+    std::string screen;
+    char buf[4096];
+    for (;;) {  // read until the child closes the terminal (EIO on Linux)
+        const ssize_t n = read(master, buf, sizeof buf);
+        if (n <= 0) break;
+        screen.append(buf, static_cast<std::size_t>(n));
+    }
+    close(master);
+    int wstatus = 0;
+    waitpid(pid, &wstatus, 0);
+    EXPECT_TRUE(WIFEXITED(wstatus) && WEXITSTATUS(wstatus) == 0) << screen;
+    return screen;
+}
+
+// ---- a minimal JSON reader, strict enough to catch malformed output ---------------------------
+
+struct Json;
+using JsonObject = std::map<std::string, Json>;
+using JsonArray = std::vector<Json>;
+struct Json {
+    std::variant<std::nullptr_t, bool, double, std::string, JsonArray, JsonObject> value;
+    const Json& operator[](const std::string& key) const {
+        const auto& object = std::get<JsonObject>(value);
+        const auto it = object.find(key);
+        if (it == object.end()) throw std::runtime_error("missing key '" + key + "'");
+        return it->second;
+    }
+    bool has(const std::string& key) const { return std::get<JsonObject>(value).contains(key); }
+    double number() const { return std::get<double>(value); }
+    bool boolean() const { return std::get<bool>(value); }
+};
+
+class JsonParser {
+  public:
+    explicit JsonParser(std::string text) : s_(std::move(text)) {}
+    Json parse_document() {
+        Json j = parse();
+        skip();
+        if (pos_ != s_.size()) fail("trailing characters");
+        return j;
+    }
+
+  private:
+    [[noreturn]] void fail(const std::string& what) const {
+        throw std::runtime_error("JSON: " + what + " at offset " + std::to_string(pos_));
+    }
+    void skip() {
+        while (pos_ < s_.size() && std::strchr(" \t\r\n", s_[pos_])) ++pos_;
+    }
+    bool eat(char c) {
+        skip();
+        if (pos_ < s_.size() && s_[pos_] == c) return ++pos_, true;
+        return false;
+    }
+    void expect(char c) {
+        if (!eat(c)) fail(std::string("expected '") + c + "'");
+    }
+    std::string parse_string() {
+        expect('"');
+        std::string out;
+        while (pos_ < s_.size() && s_[pos_] != '"') {
+            if (s_[pos_] == '\\') ++pos_;  // escapes are kept verbatim: tests compare ASCII only
+            out += s_[pos_++];
+        }
+        expect('"');
+        return out;
+    }
+    Json parse() {
+        skip();
+        if (pos_ >= s_.size()) fail("unexpected end");
+        const char c = s_[pos_];
+        if (c == '{') {
+            ++pos_;
+            JsonObject object;
+            if (eat('}')) return {object};
+            do {
+                const std::string key = parse_string();
+                expect(':');
+                object[key] = parse();
+            } while (eat(','));
+            expect('}');
+            return {object};
+        }
+        if (c == '[') {
+            ++pos_;
+            JsonArray array;
+            if (eat(']')) return {array};
+            do array.push_back(parse());
+            while (eat(','));
+            expect(']');
+            return {array};
+        }
+        if (c == '"') return {parse_string()};
+        for (const auto& [word, value] : {std::pair<const char*, Json>{"true", {true}},
+                                          {"false", {false}},
+                                          {"null", {nullptr}}}) {
+            if (s_.compare(pos_, std::strlen(word), word) == 0) {
+                pos_ += std::strlen(word);
+                return value;
+            }
+        }
+        // JSON numbers only: no inf, nan, hex or leading plus.
+        static const std::regex number(R"(^-?(0|[1-9][0-9]*)(\.[0-9]+)?([eE][-+]?[0-9]+)?)");
+        std::smatch m;
+        const std::string rest = s_.substr(pos_, 64);
+        if (!std::regex_search(rest, m, number)) fail("bad value");
+        pos_ += m.length();
+        return {std::stod(m.str())};
+    }
+
+    std::string s_;
+    std::size_t pos_ = 0;
+};
+
+Json parse_json(const std::string& text) {
+    return JsonParser(text).parse_document();
+}
+
+// ---- fixture ------------------------------------------------------------------------------------
+
+// A small scene that calls for antialiasing and soft shadows and has a mirror and glass: every ray
+// kind is traced, and it renders in milliseconds.
+constexpr const char* kScene = R"(<?xml version="1.0"?>
+<Scene>
+  <Image Width="24" Height="16"/>
+  <Render Samples="4" ShadowRays="2" Seed="3"/>
+  <Background r="0.1" g="0.2" b="0.3"/>
+  <Camera Ex="0" Ey="2" Ez="-8" Lx="0" Ly="1" Lz="0" Fov="40"/>
+  <Materials>
+    <Grey kdr="0.7" kdg="0.7" kdb="0.7" diffuse="1"/>
+    <Mirror reflective="1" ksr="0.9" ksg="0.9" ksb="0.9"/>
+    <Glass transmitt="1" index="1.5"/>
+  </Materials>
+  <Light Px="2" Py="6" Pz="-2" Radius="0.8" Ir="1" Ig="1" Ib="1"/>
+  <Plane Px="0" Py="0" Pz="0" Vu="0" Vv="1" Vw="0" Material="Grey"/>
+  <Sphere Px="-1.2" Py="1" Pz="0" Radius="1" Material="Mirror"/>
+  <Sphere Px="1.2" Py="1" Pz="0" Radius="1" Material="Glass"/>
+</Scene>
+)";
+
+class CliTest : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir_ = fs::temp_directory_path() / ("drt_cli_test_" + std::to_string(getpid()) + "_" +
+                                            info->test_suite_name() + "_" + info->name());
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+        write_bytes(dir_ / "scene.xml", kScene);
+    }
+    void TearDown() override {
+        if (!HasFailure()) fs::remove_all(dir_);
+    }
+
+    Outcome run(const std::vector<std::string>& args) const { return run_drt(args, dir_); }
+    fs::path file(const std::string& name) const { return dir_ / name; }
+    // Every name in the folder, so a test can see that nothing (not even a temporary) was left.
+    std::vector<std::string> entries(const fs::path& folder) const {
+        std::vector<std::string> names;
+        for (const auto& e : fs::directory_iterator(folder)) names.push_back(e.path().filename());
+        std::sort(names.begin(), names.end());
+        return names;
+    }
+
+    fs::path dir_;
+};
+
+// ---- usage -------------------------------------------------------------------------------------
+
+TEST_F(CliTest, HelpListsTheContractOptionsAndExitsZero) {
+    for (const char* flag : {"--help", "-h"}) {
+        const Outcome r = run({flag});
+        EXPECT_EQ(r.status, 0) << flag;
+        EXPECT_EQ(r.err, "");
+        for (const char* option : {"--output", "--spp", "--shadow-rays", "--width", "--height",
+                                   "--seed", "--threads", "--stats", "--quiet", "--version"}) {
+            EXPECT_NE(r.out.find(option), std::string::npos) << flag << " lacks " << option;
+        }
+    }
+    const Outcome compare = run({"compare", "--help"});
+    EXPECT_EQ(compare.status, 0);
+    for (const char* option : {"--max-rmse", "--min-psnr", "--diff"}) {
+        EXPECT_NE(compare.out.find(option), std::string::npos) << option;
+    }
+}
+
+TEST_F(CliTest, VersionPrintsNameAndVersion) {
+    const Outcome r = run({"--version"});
+    EXPECT_EQ(r.status, 0);
+    EXPECT_EQ(r.out, std::string("drt ") + DRT_VERSION + "\n");
+}
+
+TEST_F(CliTest, BadUsageExitsTwoAndWritesNothing) {
+    const std::vector<std::vector<std::string>> cases{
+        {},
+        {"scene.xml", "--bogus"},
+        {"scene.xml", "--spp", "0"},
+        {"scene.xml", "--spp", "many"},
+        {"scene.xml", "--threads", "0"},
+        {"scene.xml", "--width", "-5"},
+        {"scene.xml", "-o", "out.jpg"},  // unknown format: refused before rendering
+        {"compare", "only-one.png"},
+        {"info"},
+    };
+    for (const auto& args : cases) {
+        const Outcome r = run(args);
+        std::string joined;
+        for (const auto& a : args) joined += a + " ";
+        EXPECT_EQ(r.status, 2) << joined << "\n" << r.err;
+        EXPECT_NE(r.err, "") << joined;
+    }
+    EXPECT_EQ(entries(dir_), std::vector<std::string>{"scene.xml"});
+}
+
+// ---- malformed scenes -------------------------------------------------------------------------
+
+struct BadScene {
+    const char* name;
+    std::string content;
+    std::string message;  // the whole first line of stderr after "FILE:"
+};
+
+std::vector<BadScene> bad_scenes() {
+    const std::string head =
+        "<?xml version=\"1.0\"?>\n<Scene>\n  <Image Width=\"8\" Height=\"6\"/>\n";
+    const std::string grey = "  <Materials><Grey kdr=\"0.5\"/></Materials>\n";
+    return {
+        {"truncated_mid_tag", head + "  <Sphere Px=\"1\" Py=\"2\" Pz=\"3\" Rad",
+         "4: XML: malformed or repeated attribute"},
+        {"truncated_unclosed",
+         head + grey +
+             "  <Objects>\n    <Sphere Px=\"0\" Py=\"0\" Pz=\"5\" "
+             "Radius=\"1\" Material=\"Grey\"/>\n",
+         "5: XML: malformed xml"},
+        {"bad_number",
+         head + grey +
+             "  <Sphere Px=\"1\" Py=\"2\" Pz=\"3\" Radius=\"0.5abc\" "
+             "Material=\"Grey\"/>\n</Scene>\n",
+         "5: Sphere: attribute 'Radius' is not a number: \"0.5abc\""},
+        {"nan_number", head + "  <Light Px=\"nan\" Py=\"2\" Pz=\"3\"/>\n</Scene>\n",
+         "4: Light: attribute 'Px' is not a number: \"nan\""},
+        {"empty_number", head + "  <Render Samples=\"\"/>\n</Scene>\n",
+         "4: Render: attribute 'Samples' is not an integer: \"\""},
+        {"negative_radius",
+         head + grey +
+             "\n\n  <Sphere Px=\"1\" Py=\"2\" Pz=\"3\" Radius=\"-1\" "
+             "Material=\"Grey\"/>\n</Scene>\n",
+         "7: Sphere: negative radius -1"},
+        {"negative_light_radius",
+         head + "  <Light Px=\"1\" Py=\"1\" Pz=\"1\" Radius=\"-2\"/>\n</Scene>",
+         "4: Light: negative radius -2"},
+        {"unknown_material",
+         head + grey +
+             "  <Sphere Px=\"1\" Py=\"2\" Pz=\"3\" Radius=\"1\"\n"
+             "          Material=\"Glass\"/>\n</Scene>\n",
+         "5: Sphere: unknown material 'Glass'"},
+        {"zero_normal",
+         head + grey +
+             "  <Plane Px=\"0\" Py=\"0\" Pz=\"0\" Vu=\"0\" Vv=\"0\" Vw=\"0\" "
+             "Material=\"Grey\"/>\n</Scene>\n",
+         "5: Plane: zero-length normal"},
+        {"zero_width", "<Scene>\n\n  <Image Width=\"0\" Height=\"6\"/>\n</Scene>\n",
+         "3: Image: Width must be positive, got 0"},
+        {"missing_attribute",
+         head + grey + "  <Sphere Px=\"1\" Py=\"2\" Pz=\"3\" Material=\"Grey\"/>\n</Scene>\n",
+         "5: Sphere: missing required attribute 'Radius'"},
+        {"wrong_root", "<?xml version=\"1.0\"?>\n<Scena/>\n",
+         "2: Scena: root element must be <Scene>"},
+        {"empty_file", "", "1: XML: empty document"},
+        {"blank_file", "\n\n   \n", "1: XML: empty document"},
+        {"binary_file", std::string("\x89PNG\r\n\x1a\n\0\0\0\rIHDR\0\0\x01\x02", 20),
+         "3: XML: nul byte in input (not a text file?)"},
+    };
+}
+
+TEST_F(CliTest, EveryMalformedSceneExitsTwoNamingFileAndLineAndWritesNothing) {
+    const std::string existing = "precious bytes\n";
+    for (const BadScene& bad : bad_scenes()) {
+        SCOPED_TRACE(bad.name);
+        const fs::path folder = dir_ / bad.name;
+        fs::create_directory(folder);
+        const std::string scene = std::string(bad.name) + ".xml";
+        write_bytes(folder / scene, bad.content);
+        write_bytes(folder / "kept.png", existing);
+        write_bytes(folder / "kept.pfm", existing);
+        write_bytes(folder / "stats.json", existing);
+
+        for (const char* out : {"kept.png", "kept.pfm", "new.png", "new.bmp"}) {
+            const Outcome r = run_drt({scene, "-o", out, "--stats", "stats.json"}, folder);
+            EXPECT_EQ(r.status, 2) << out;
+            EXPECT_EQ(r.err.substr(0, r.err.find('\n')), scene + ":" + bad.message) << out;
+            EXPECT_EQ(r.out, "");
+        }
+        // Without -o the default output would be <name>.png in the current folder.
+        const Outcome r = run_drt({scene}, folder);
+        EXPECT_EQ(r.status, 2);
+        EXPECT_EQ(read_bytes(folder / "kept.png"), existing);
+        EXPECT_EQ(read_bytes(folder / "kept.pfm"), existing);
+        EXPECT_EQ(read_bytes(folder / "stats.json"), existing);
+        std::vector<std::string> expected{"kept.pfm", "kept.png", scene, "stats.json"};
+        std::sort(expected.begin(), expected.end());
+        EXPECT_EQ(entries(folder), expected);
+    }
+}
+
+TEST_F(CliTest, MissingOrUnreadableSceneExitsTwoNamingIt) {
+    write_bytes(file("kept.png"), "x");
+    fs::create_directory(file("folder.xml"));
+    for (const char* scene : {"missing.xml", "folder.xml"}) {
+        const Outcome r = run({scene, "-o", "kept.png"});
+        EXPECT_EQ(r.status, 2) << scene;
+        EXPECT_EQ(r.err.rfind(std::string(scene) + ": cannot open scene: ", 0), 0u) << r.err;
+        EXPECT_EQ(read_bytes(file("kept.png")), "x");
+    }
+}
+
+TEST_F(CliTest, InfoDescribesAGoodSceneAndRejectsABadOne) {
+    const Outcome good = run({"info", "scene.xml"});
+    EXPECT_EQ(good.status, 0) << good.err;
+    EXPECT_NE(good.out.find("soft"), std::string::npos) << good.out;
+    write_bytes(file("bad.xml"), "<Scene>\n<Sphere Px=\"1\"/>\n</Scene>\n");
+    const Outcome bad = run({"info", "bad.xml"});
+    EXPECT_EQ(bad.status, 2);
+    EXPECT_EQ(bad.err.rfind("bad.xml:2: Sphere: ", 0), 0u) << bad.err;
+}
+
+// ---- image files -------------------------------------------------------------------------------
+
+std::uint32_t be32(const std::string& s, std::size_t at) {
+    std::uint32_t v = 0;
+    for (int k = 0; k < 4; ++k) v = v << 8 | static_cast<unsigned char>(s[at + k]);
+    return v;
+}
+
+std::int32_t le32(const std::string& s, std::size_t at) {
+    std::uint32_t v = 0;
+    for (int k = 3; k >= 0; --k) v = v << 8 | static_cast<unsigned char>(s[at + k]);
+    return static_cast<std::int32_t>(v);
+}
+
+TEST_F(CliTest, PngBmpAndPfmHeadersCarryTheRequestedSize) {
+    ASSERT_EQ(run({"scene.xml", "-q", "--width", "19", "--height", "7", "-o", "a.png"}).status, 0);
+    ASSERT_EQ(run({"scene.xml", "-q", "--width", "19", "--height", "7", "-o", "a.bmp"}).status, 0);
+    ASSERT_EQ(run({"scene.xml", "-q", "--width", "19", "--height", "7", "-o", "a.pfm"}).status, 0);
+
+    const std::string png = read_bytes(file("a.png"));
+    ASSERT_GE(png.size(), 33u);
+    EXPECT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+    EXPECT_EQ(png.substr(12, 4), "IHDR");
+    EXPECT_EQ(be32(png, 16), 19u);
+    EXPECT_EQ(be32(png, 20), 7u);
+    EXPECT_EQ(png[24], 8);  // bits per channel
+    EXPECT_EQ(png[25], 2);  // colour type RGB
+
+    const std::string bmp = read_bytes(file("a.bmp"));
+    ASSERT_GE(bmp.size(), 54u);
+    EXPECT_EQ(bmp.substr(0, 2), "BM");
+    EXPECT_EQ(le32(bmp, 2), static_cast<std::int32_t>(bmp.size()));
+    EXPECT_EQ(le32(bmp, 18), 19);
+    EXPECT_EQ(std::abs(le32(bmp, 22)), 7);
+
+    const std::string pfm = read_bytes(file("a.pfm"));
+    const std::string header = "PF\n19 7\n-1.0\n";
+    EXPECT_EQ(pfm.substr(0, header.size()), header);
+    EXPECT_EQ(pfm.size(), header.size() + 19 * 7 * 3 * 4);
+
+    // The 8-bit files hold the sRGB encoding of the linear .pfm values.
+    const Image linear = read_image(file("a.pfm"));
+    const Image encoded = read_image(file("a.png"));
+    const Image bmp_image = read_image(file("a.bmp"));
+    ASSERT_EQ(encoded.rgb.size(), linear.rgb.size());
+    for (std::size_t i = 0; i < linear.rgb.size(); ++i) {
+        EXPECT_EQ(std::lround(encoded.rgb[i] * 255), encode_srgb8(linear.rgb[i])) << i;
+        EXPECT_EQ(bmp_image.rgb[i], encoded.rgb[i]) << i;
+    }
+}
+
+TEST_F(CliTest, DefaultOutputIsTheScenesNameAsPngInTheCurrentFolder) {
+    fs::create_directory(file("sub"));
+    fs::copy_file(file("scene.xml"), file("sub/room.xml"));
+    const Outcome r = run({"sub/room.xml", "-q"});
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.err, "");  // -q: no progress, no "wrote" message
+    EXPECT_TRUE(fs::exists(file("room.png")));
+    EXPECT_FALSE(fs::exists(file("sub/room.png")));
+}
+
+TEST_F(CliTest, RerenderReplacesAnExistingOutputAndLeavesNoTemporaries) {
+    write_bytes(file("out.pfm"), "old");
+    ASSERT_EQ(run({"scene.xml", "-q", "-o", "out.pfm"}).status, 0);
+    EXPECT_EQ(read_image(file("out.pfm")).width, 24);
+    EXPECT_EQ(entries(dir_), (std::vector<std::string>{"out.pfm", "scene.xml"}));
+}
+
+TEST_F(CliTest, UnwritableOutputExitsOne) {
+    const Outcome r = run({"scene.xml", "-q", "-o", "no/such/folder/out.png"});
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.err.find("no/such/folder/out.png"), std::string::npos) << r.err;
+}
+
+// ---- determinism
+// ---------------------------------------------------------------------------------
+
+TEST_F(CliTest, PfmIsBitIdenticalForAnyThreadCountAndRunAndChangesWithTheSeed) {
+    ASSERT_EQ(run({"scene.xml", "-q", "--threads", "1", "-o", "t1.pfm"}).status, 0);
+    ASSERT_EQ(run({"scene.xml", "-q", "--threads", "2", "-o", "t2.pfm"}).status, 0);
+    ASSERT_EQ(run({"scene.xml", "-q", "--threads", "7", "-o", "t7.pfm"}).status, 0);
+    ASSERT_EQ(run({"scene.xml", "-q", "--threads", "2", "-o", "again.pfm"}).status, 0);
+    ASSERT_EQ(run({"scene.xml", "-q", "--seed", "3", "-o", "seed3.pfm"}).status, 0);
+    ASSERT_EQ(run({"scene.xml", "-q", "--seed", "4", "-o", "seed4.pfm"}).status, 0);
+    const std::string reference = read_bytes(file("t1.pfm"));
+    ASSERT_EQ(reference.size(), std::string("PF\n24 16\n-1.0\n").size() + 24 * 16 * 12);
+    EXPECT_EQ(read_bytes(file("t2.pfm")), reference);
+    EXPECT_EQ(read_bytes(file("t7.pfm")), reference);
+    EXPECT_EQ(read_bytes(file("again.pfm")), reference);
+    EXPECT_EQ(read_bytes(file("seed3.pfm")), reference);  // the scene's own Seed is 3
+    // Another seed draws other samples: most pixels change, though each only by noise.
+    const Image a = read_image(file("seed3.pfm")), b = read_image(file("seed4.pfm"));
+    int changed = 0;
+    for (std::size_t i = 0; i < a.rgb.size(); ++i) changed += a.rgb[i] != b.rgb[i];
+    EXPECT_GT(changed, static_cast<int>(a.rgb.size() / 4));
+}
+
+// ---- statistics -------------------------------------------------------------------------------
+
+TEST_F(CliTest, StatsJsonHasEveryContractKeyAndRaysAddUp) {
+    const Outcome r = run({"scene.xml", "-q", "--spp", "3", "--stats", "-", "-o", "a.pfm"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const Json j = parse_json(r.out);
+    EXPECT_GE(j["seconds"].number(), 0);
+    EXPECT_EQ(j["width"].number(), 24);
+    EXPECT_EQ(j["height"].number(), 16);
+    EXPECT_EQ(j["samples_per_pixel"].number(), 3);
+    const Json& rays = j["rays"];
+    EXPECT_EQ(rays["camera"].number(), 24 * 16 * 3);
+    EXPECT_GT(rays["shadow"].number(), 0);
+    EXPECT_GT(rays["reflection"].number(), 0);
+    EXPECT_GT(rays["refraction"].number(), 0);
+    if (rays.has("total")) {
+        EXPECT_EQ(rays["total"].number(), rays["camera"].number() + rays["shadow"].number() +
+                                              rays["reflection"].number() +
+                                              rays["refraction"].number());
+    }
+    const Json& effects = j["effects"];
+    EXPECT_TRUE(effects["antialiasing"].boolean());
+    EXPECT_TRUE(effects["soft_shadows"].boolean());
+    EXPECT_FALSE(effects["glossy_reflection"].boolean());
+    EXPECT_FALSE(effects["glossy_refraction"].boolean());
+    EXPECT_FALSE(effects["depth_of_field"].boolean());
+    EXPECT_FALSE(effects["motion_blur"].boolean());
+
+    // To a file, the same keys; the count of camera rays does not depend on the thread count.
+    const Outcome to_file = run({"scene.xml", "-q", "--spp", "3", "--threads", "1", "--stats",
+                                 "stats.json", "-o", "b.pfm"});
+    ASSERT_EQ(to_file.status, 0) << to_file.err;
+    EXPECT_EQ(to_file.out, "");
+    const Json f = parse_json(read_bytes(file("stats.json")));
+    for (const char* kind : {"camera", "shadow", "reflection", "refraction"}) {
+        EXPECT_EQ(f["rays"][kind].number(), rays[kind].number()) << kind;
+    }
+}
+
+TEST_F(CliTest, StatsShowOnlyWhatASceneCallsFor) {
+    // One sample per pixel and a point light: no antialiasing, one shadow ray per shading point.
+    const Outcome r = run({"scene.xml", "-q", "--spp", "1", "--stats", "-", "-o", "a.pfm"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_FALSE(parse_json(r.out)["effects"]["antialiasing"].boolean());
+}
+
+// ---- batch
+// ----------------------------------------------------------------------------------------
+
+TEST_F(CliTest, BatchRendersEveryGoodSceneReportsAndExitsWithTheHighestStatus) {
+    fs::copy_file(file("scene.xml"), file("a.xml"));
+    write_bytes(file("bad.xml"),
+                "<Scene>\n  <Sphere Px=\"1\" Py=\"1\" Pz=\"1\" Radius=\"-3\" "
+                "Material=\"Grey\"/>\n</Scene>\n");
+    std::string c = kScene;
+    c.replace(c.find("Width=\"24\""), 10, "Width=\"30\"");
+    write_bytes(file("c.xml"), c);
+
+    const Outcome r = run({"a.xml", "bad.xml", "c.xml", "-o", "out/renders/", "-q"});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(entries(file("out/renders")), (std::vector<std::string>{"a.png", "c.png"}));
+    EXPECT_EQ(read_image(file("out/renders/a.png")).width, 24);
+    EXPECT_EQ(read_image(file("out/renders/c.png")).width, 30);
+    EXPECT_NE(r.err.find("bad.xml:2: Sphere: negative radius -3"), std::string::npos) << r.err;
+
+    // The summary: a header, then one row per scene in the order given.
+    std::vector<std::string> lines;
+    for (std::size_t start = 0, end; (end = r.out.find('\n', start)) != std::string::npos;
+         start = end + 1) {
+        lines.push_back(r.out.substr(start, end - start));
+    }
+    ASSERT_EQ(lines.size(), 4u) << r.out;
+    const std::regex header(R"(^scene +size +samples +seconds +Mrays/s +status$)");
+    EXPECT_TRUE(std::regex_search(lines[0], header)) << lines[0];
+    const std::regex good(R"(^(a|c)\.xml +(24|30)x16 +4 +[0-9]+\.[0-9]{2} +[0-9]+\.[0-9]{2} +ok$)");
+    EXPECT_TRUE(std::regex_search(lines[1], good)) << lines[1];
+    EXPECT_TRUE(std::regex_search(lines[3], good)) << lines[3];
+    EXPECT_NE(lines[1].find("24x16"), std::string::npos);
+    EXPECT_NE(lines[3].find("30x16"), std::string::npos);
+    EXPECT_TRUE(std::regex_search(lines[2], std::regex(R"(^bad\.xml .* bad input$)"))) << lines[2];
+
+    // All good: exit 0; an existing folder is fine.
+    const Outcome ok = run({"a.xml", "c.xml", "-o", "out/renders", "-q"});
+    EXPECT_EQ(ok.status, 0) << ok.err;
+}
+
+TEST_F(CliTest, BatchStatsListEveryRenderedScene) {
+    fs::copy_file(file("scene.xml"), file("a.xml"));
+    fs::copy_file(file("scene.xml"), file("b.xml"));
+    const Outcome r = run({"a.xml", "b.xml", "-o", "out", "-q", "--stats", "-"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const Json j = parse_json(r.out);  // the summary table goes to stderr here
+    const auto& scenes = std::get<JsonArray>(j["scenes"].value);
+    ASSERT_EQ(scenes.size(), 2u);
+    for (const Json& s : scenes) EXPECT_EQ(s["rays"]["camera"].number(), 24 * 16 * 4);
+    EXPECT_NE(r.err.find("a.xml"), std::string::npos);
+}
+
+// ---- compare -----------------------------------------------------------------------------------
+
+class CompareCliTest : public CliTest {
+  protected:
+    void SetUp() override {
+        CliTest::SetUp();
+        write_image(constant(4, 3, 0.25f), file("quarter.pfm"));
+        write_image(constant(4, 3, 0.25f), file("quarter2.pfm"));
+        write_image(constant(4, 3, 0.5f), file("half.pfm"));
+        write_image(constant(5, 3, 0.25f), file("wide.pfm"));
+    }
+    static Image constant(int w, int h, float v) {
+        Image image(w, h);
+        std::fill(image.rgb.begin(), image.rgb.end(), v);
+        return image;
+    }
+};
+
+TEST_F(CompareCliTest, EqualImagesExitZeroWithZeroError) {
+    const Outcome r = run({"compare", "quarter.pfm", "quarter2.pfm", "--max-rmse", "0"});
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.out.rfind("rmse=0 psnr=inf ssim=1 ", 0), 0u) << r.out;
+}
+
+TEST_F(CompareCliTest, DifferentImagesPrintTheirErrorAndFailOnlyBeyondTolerance) {
+    // Every value differs by 0.25: rmse 0.25, psnr 20 log10(4) = 12.0412 dB.
+    const Outcome plain = run({"compare", "quarter.pfm", "half.pfm"});
+    EXPECT_EQ(plain.status, 0);
+    EXPECT_EQ(plain.out.rfind("rmse=0.25 psnr=12.0412 ", 0), 0u) << plain.out;
+
+    EXPECT_EQ(run({"compare", "quarter.pfm", "half.pfm", "--max-rmse", "0.25"}).status, 0);
+    const Outcome over = run({"compare", "quarter.pfm", "half.pfm", "--max-rmse", "0.2499"});
+    EXPECT_EQ(over.status, 1);
+    EXPECT_NE(over.err.find("exceeds --max-rmse"), std::string::npos) << over.err;
+    EXPECT_EQ(run({"compare", "quarter.pfm", "half.pfm", "--min-psnr", "12"}).status, 0);
+    EXPECT_EQ(run({"compare", "quarter.pfm", "half.pfm", "--min-psnr", "12.1"}).status, 1);
+}
+
+TEST_F(CompareCliTest, SizeMismatchUnreadableAndMixedFormatsExitTwo) {
+    const Outcome size = run({"compare", "quarter.pfm", "wide.pfm", "--diff", "d.png"});
+    EXPECT_EQ(size.status, 2);
+    EXPECT_NE(size.err.find("4x3 vs 5x3"), std::string::npos) << size.err;
+    write_bytes(file("garbage.png"), "not a png at all");
+    write_image(constant(4, 3, 0.25f), file("quarter.png"));
+    for (const auto& [a, b] : std::vector<std::pair<std::string, std::string>>{
+             {"quarter.pfm", "missing.pfm"},
+             {"garbage.png", "quarter.png"},
+             {"quarter.pfm", "quarter.png"},  // linear floats against sRGB bytes
+             {"quarter.pfm", "notes.txt"}}) {
+        const Outcome r = run({"compare", a, b, "--diff", "d.png"});
+        EXPECT_EQ(r.status, 2) << a << " " << b;
+        EXPECT_NE(r.err.find(a == "garbage.png" ? a : b), std::string::npos) << r.err;
+    }
+    EXPECT_FALSE(fs::exists(file("d.png")));
+    // 8-bit files of either kind compare with each other.
+    write_image(constant(4, 3, 0.25f), file("quarter.bmp"));
+    EXPECT_EQ(run({"compare", "quarter.png", "quarter.bmp", "--max-rmse", "0"}).status, 0);
+}
+
+TEST_F(CompareCliTest, NanNeverPassesATolerance) {
+    Image nan_image = constant(4, 3, 0.25f);
+    nan_image.rgb[5] = std::numeric_limits<float>::quiet_NaN();
+    write_image(nan_image, file("nan.pfm"));
+    const Outcome plain = run({"compare", "quarter.pfm", "nan.pfm"});
+    EXPECT_EQ(plain.status, 0);
+    EXPECT_NE(plain.out.find("rmse=nan"), std::string::npos) << plain.out;
+    EXPECT_NE(plain.out.find("nonfinite=1"), std::string::npos) << plain.out;
+    EXPECT_EQ(run({"compare", "quarter.pfm", "nan.pfm", "--max-rmse", "1e30"}).status, 1);
+    EXPECT_EQ(run({"compare", "nan.pfm", "nan.pfm", "--max-rmse", "1e30"}).status, 1);
+    EXPECT_EQ(run({"compare", "quarter.pfm", "nan.pfm", "--min-psnr", "-1e30"}).status, 1);
+
+    Image inf_image = constant(4, 3, 0.25f);
+    inf_image.rgb[0] = std::numeric_limits<float>::infinity();
+    write_image(inf_image, file("inf.pfm"));
+    EXPECT_EQ(run({"compare", "quarter.pfm", "inf.pfm", "--max-rmse", "1e30"}).status, 1);
+}
+
+TEST_F(CompareCliTest, DiffWritesAFalseColourImageOfTheSameSize) {
+    Image spot = constant(4, 3, 0.25f);
+    spot.set(2, 1, {0.9, 0.25, 0.25});
+    write_image(spot, file("spot.pfm"));
+    const Outcome r = run({"compare", "quarter.pfm", "spot.pfm", "--diff", "d.png"});
+    EXPECT_EQ(r.status, 0) << r.err;
+    const Image d = read_image(file("d.png"));
+    ASSERT_EQ(d.width, 4);
+    ASSERT_EQ(d.height, 3);
+    EXPECT_EQ(d.at(2, 1), (Color{1, 0, 0}));  // the largest error: red
+    EXPECT_EQ(d.at(0, 0), (Color{0, 0, 0}));  // equal: black
+    // An unwritable diff is reported after the measures, with status 1.
+    const Outcome bad = run({"compare", "quarter.pfm", "spot.pfm", "--diff", "no/such/d.png"});
+    EXPECT_EQ(bad.status, 1);
+    EXPECT_EQ(bad.out.rfind("rmse=", 0), 0u);
+}
+
+// ---- progress
+// ------------------------------------------------------------------------------------
+
+// Long enough on one thread that the display updates before the end (it does every 250 ms).
+const std::vector<std::string> kSlowRender{"scene.xml", "--threads", "1",    "--width",
+                                           "240",       "--height",  "160",  "--spp",
+                                           "64",        "-o",        "p.png"};
+
+std::vector<std::string> with(std::vector<std::string> args, const std::vector<std::string>& more) {
+    args.insert(args.end(), more.begin(), more.end());
+    return args;
+}
+
+TEST_F(CliTest, ProgressShowsPercentElapsedAndRemainingWhenForced) {
+    const Outcome r = run(with(kSlowRender, {"--progress"}));
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::regex update(
+        R"(\rscene\.xml +[0-9]{1,2}%  [0-9]+:[0-9]{2} elapsed, [0-9]+:[0-9]{2} left)");
+    EXPECT_TRUE(std::regex_search(r.err, update)) << r.err;
+    const std::regex last(R"(\rscene\.xml 100%  [0-9]+:[0-9]{2} elapsed *\n)");
+    EXPECT_TRUE(std::regex_search(r.err, last)) << r.err;
+    EXPECT_EQ(r.out, "");  // never on stdout
+}
+
+TEST_F(CliTest, NoProgressWhenStderrIsNotATerminalOrWhenQuiet) {
+    const Outcome piped = run({"scene.xml", "-o", "p.png"});
+    EXPECT_EQ(piped.status, 0);
+    EXPECT_EQ(piped.err.find('%'), std::string::npos) << piped.err;
+    EXPECT_EQ(piped.err.rfind("drt: wrote p.png (24x16, 4 spp, ", 0), 0u) << piped.err;
+    const Outcome quiet = run({"scene.xml", "-o", "p.png", "-q", "--progress"});
+    EXPECT_EQ(quiet.status, 0);
+    EXPECT_EQ(quiet.err, "");
+}
+
+TEST_F(CliTest, ProgressAppearsOnATerminalUnlessQuiet) {
+    const std::string shown = run_drt_on_terminal(kSlowRender, dir_);
+    EXPECT_NE(shown.find("100%"), std::string::npos) << shown;
+    EXPECT_NE(shown.find("elapsed"), std::string::npos) << shown;
+    const std::string quiet = run_drt_on_terminal(with(kSlowRender, {"-q"}), dir_);
+    EXPECT_EQ(quiet, "");
+}
+
+}  // namespace
+}  // namespace drt
