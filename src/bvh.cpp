@@ -2,80 +2,168 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include "drt/plane.h"
+#include "drt/sphere.h"
 
 namespace drt {
 
 namespace {
 
 constexpr std::uint32_t kMaxLeafSize = 4;
+// Above this many primitives a node splits even where the SAH would rather keep a leaf
+// (primitives piled on one spot), so no leaf grows without bound.
+constexpr std::uint32_t kMaxSahLeafSize = 16;
 constexpr int kBins = 16;
 constexpr double kTraversalCost = 1.0;  // relative to one primitive test
 // Past this depth nodes split at the median, which bounds the depth of any tree by
 // kMedianDepth + log2(n) and so keeps the traversal stack below kStackSize.
 constexpr int kMedianDepth = 64;
 constexpr int kStackSize = 128;
+// Slab distances are rounded; stretching the far one by a few ulps keeps a box whose surface a
+// ray grazes from being missed (pbrt's 1 + 2γ₃).
+constexpr double kFarStretch = 1.0 + 4.0 * std::numeric_limits<double>::epsilon();
 
 Interval span(const Interval& a, const Interval& b) {
     return {std::min(a.min, b.min), std::max(a.max, b.max)};
 }
 
-// Slab test against a box; inv_dir holds 1/dir per axis (infinite for axis-parallel rays).
-bool hits_box(const Bounds& b, const Vec3& origin, const Vec3& inv_dir, double t_min, double t_max) {
-    for (int axis = 0; axis < 3; ++axis) {
-        double t0 = (b.lo[axis] - origin[axis]) * inv_dir[axis];
-        double t1 = (b.hi[axis] - origin[axis]) * inv_dir[axis];
-        if (t0 > t1) std::swap(t0, t1);
-        // NaN (0 * inf for an origin on a slab plane) must not shrink the interval.
-        if (t0 > t_min) t_min = t0;
-        if (t1 < t_max) t_max = t1;
-        if (t_min > t_max) return false;
-    }
-    return true;
+// A time bound as a float that still contains the double: down for a minimum, up for a maximum.
+float float_below(double v) {
+    float f = static_cast<float>(v);
+    if (static_cast<double>(f) > v) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+    return f;
+}
+float float_above(double v) {
+    float f = static_cast<float>(v);
+    if (static_cast<double>(f) < v) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+    return f;
 }
 
 }  // namespace
 
+// What every box test of one ray shares. A box is read as box[0..2] = lo, box[3..5] = hi, so
+// the slab the ray enters first on each axis is picked by index instead of by a swap.
+struct Bvh::RayData {
+    double origin[3];
+    double inv_dir[3];  // 1/dir, infinite for an axis-parallel ray
+    int near[3], far[3];
+    double time;
+
+    explicit RayData(const Ray& ray) : time(ray.time) {
+        const double d[3] = {ray.dir.x, ray.dir.y, ray.dir.z};
+        const double o[3] = {ray.origin.x, ray.origin.y, ray.origin.z};
+        for (int a = 0; a < 3; ++a) {
+            origin[a] = o[a];
+            inv_dir[a] = 1.0 / d[a];
+            // signbit, not < 0: a direction of -0 has an inverse of -inf and must enter at hi.
+            const bool negative = std::signbit(d[a]);
+            near[a] = negative ? 3 + a : a;
+            far[a] = negative ? a : 3 + a;
+        }
+    }
+
+    // Whether the ray is in the box at its time within [t_min, t_max]; `entry` is where it enters.
+    bool enters(const Node& node, double t_min, double t_max, double& entry) const {
+        if (!(node.time_min <= time && time <= node.time_max)) return false;
+        for (int a = 0; a < 3; ++a) {
+            const double t_near = (node.box[near[a]] - origin[a]) * inv_dir[a];
+            const double t_far = (node.box[far[a]] - origin[a]) * inv_dir[a] * kFarStretch;
+            // Written so that NaN (0 * inf for an origin on a slab plane) leaves the bound alone.
+            t_min = t_near > t_min ? t_near : t_min;
+            t_max = t_far < t_max ? t_far : t_max;
+        }
+        entry = t_min;
+        return t_min <= t_max;
+    }
+};
+
 Bvh::Bvh(const std::vector<std::unique_ptr<Object>>& objects) {
-    for (const auto& object : objects) {
-        const auto pieces = object->motion_bounds();
-        if (pieces.empty()) unbounded_.push_back(object.get());
-        for (const auto& piece : pieces) primitives_.push_back({object.get(), piece.bounds, piece.time});
+    std::vector<Primitive> pieces;
+    std::vector<Build> items;
+    for (const auto& owned : objects) {
+        const Object* object = owned.get();
+        if (const auto* plane = dynamic_cast<const drt::Plane*>(object)) {
+            planes_.push_back({plane->point(), plane->normal(), max_abs_component(plane->point()),
+                               dot(plane->point(), plane->normal()), object});
+            continue;
+        }
+        const std::vector<TimedBounds> bounds = object->motion_bounds();
+        if (bounds.empty()) {
+            unbounded_.push_back(object);
+            continue;
+        }
+        const auto* sphere = dynamic_cast<const Sphere*>(object);
+        for (std::size_t k = 0; k < bounds.size(); ++k) {
+            Primitive p{};
+            p.object = object;
+            p.time = bounds[k].time;
+            p.kind = Kind::kOther;
+            if (sphere) {
+                // One piece per path segment (Sphere::motion_bounds), segment k from path[k].
+                const std::vector<Vec3>& path = sphere->path();
+                p.centre = path[k];
+                p.radius = sphere->radius();
+                p.kind = path.size() == 1 ? Kind::kStillSphere : Kind::kMovingSphere;
+                if (p.kind == Kind::kMovingSphere) {
+                    p.motion = static_cast<std::uint32_t>(motions_.size());
+                    motions_.push_back(
+                        {path[k + 1] - path[k], path[k + 1], static_cast<double>(k)});
+                }
+            }
+            items.push_back(
+                {bounds[k].bounds, bounds[k].time, static_cast<std::uint32_t>(pieces.size())});
+            pieces.push_back(p);
+        }
     }
-    if (!primitives_.empty()) {
-        nodes_.reserve(2 * primitives_.size());
-        build(0, static_cast<std::uint32_t>(primitives_.size()), 0);
-    }
+    if (items.empty()) return;
+    nodes_.reserve(2 * items.size());
+    build(items, 0, static_cast<std::uint32_t>(items.size()), 0);
+    primitives_.reserve(items.size());
+    for (const Build& item : items) primitives_.push_back(pieces[item.primitive]);
 }
 
-std::uint32_t Bvh::build(std::uint32_t begin, std::uint32_t end, int depth) {
+std::uint32_t Bvh::build(std::vector<Build>& items, std::uint32_t begin, std::uint32_t end,
+                         int depth) {
     const auto index = static_cast<std::uint32_t>(nodes_.size());
     nodes_.push_back({});
     Bounds bounds, centres;
     Interval time{kInfinity, -kInfinity};
     for (std::uint32_t i = begin; i < end; ++i) {
-        bounds.grow(primitives_[i].bounds);
-        centres.grow(primitives_[i].bounds.centre());
-        time = span(time, primitives_[i].time);
+        bounds.grow(items[i].bounds);
+        centres.grow(items[i].bounds.centre());
+        time = span(time, items[i].time);
     }
-    nodes_[index].bounds = bounds;
-    nodes_[index].time = time;
+    {
+        Node& node = nodes_[index];
+        for (int a = 0; a < 3; ++a) node.box[a] = bounds.lo[a], node.box[3 + a] = bounds.hi[a];
+        node.time_min = float_below(time.min);
+        node.time_max = float_above(time.max);
+    }
     const std::uint32_t count = end - begin;
 
     // Binned surface-area heuristic over the centroids' longest axis.
     const Vec3 extent = centres.extent();
-    const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+    const int axis =
+        extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
     const double lo = centres.lo[axis], width = extent[axis];
+    auto by_centre = [&](const Build& a, const Build& b) {
+        return a.bounds.centre()[axis] < b.bounds.centre()[axis];
+    };
     std::uint32_t mid = begin;
     if (count > kMaxLeafSize && width > 0 && depth < kMedianDepth) {
         std::array<Bounds, kBins> bin_bounds{};
         std::array<std::uint32_t, kBins> bin_counts{};
-        auto bin_of = [&](const Primitive& p) {
-            const int b = static_cast<int>(kBins * (p.bounds.centre()[axis] - lo) / width);
+        auto bin_of = [&](const Build& item) {
+            const int b = static_cast<int>(kBins * (item.bounds.centre()[axis] - lo) / width);
             return std::clamp(b, 0, kBins - 1);
         };
         for (std::uint32_t i = begin; i < end; ++i) {
-            const int b = bin_of(primitives_[i]);
-            bin_bounds[b].grow(primitives_[i].bounds);
+            const int b = bin_of(items[i]);
+            bin_bounds[b].grow(items[i].bounds);
             ++bin_counts[b];
         }
         double best_cost = kInfinity;
@@ -86,47 +174,71 @@ std::uint32_t Bvh::build(std::uint32_t begin, std::uint32_t end, int depth) {
             for (int b = 0; b < split; ++b) left.grow(bin_bounds[b]), n_left += bin_counts[b];
             for (int b = split; b < kBins; ++b) right.grow(bin_bounds[b]), n_right += bin_counts[b];
             if (n_left == 0 || n_right == 0) continue;
-            const double cost = kTraversalCost + (left.surface_area() * n_left +
-                                                  right.surface_area() * n_right) /
-                                                     bounds.surface_area();
+            const double cost =
+                kTraversalCost + (left.surface_area() * n_left + right.surface_area() * n_right) /
+                                     bounds.surface_area();
             if (cost < best_cost) best_cost = cost, best_split = split;
         }
         if (best_split > 0 && best_cost < count) {
             mid = static_cast<std::uint32_t>(
-                std::partition(primitives_.begin() + begin, primitives_.begin() + end,
-                               [&](const Primitive& p) { return bin_of(p) < best_split; }) -
-                primitives_.begin());
-        } else if (count > 255) {
-            mid = median_split(begin, end, axis);  // a leaf must stay small enough to count in 16 bits
+                std::partition(items.begin() + begin, items.begin() + end,
+                               [&](const Build& item) { return bin_of(item) < best_split; }) -
+                items.begin());
         }
-    } else if (count > kMaxLeafSize && (depth >= kMedianDepth || count > 255)) {
-        mid = median_split(begin, end, axis);
+    }
+    if ((mid == begin || mid == end) && count > kMaxLeafSize &&
+        (depth >= kMedianDepth || count > kMaxSahLeafSize)) {
+        mid = begin + count / 2;
+        std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
+                         by_centre);
     }
     if (mid == begin || mid == end) {
         nodes_[index].offset = begin;
-        nodes_[index].count = static_cast<std::uint16_t>(count);
+        nodes_[index].count = count;
         return index;
     }
-    build(begin, mid, depth + 1);
-    const std::uint32_t second = build(mid, end, depth + 1);
+    build(items, begin, mid, depth + 1);
+    const std::uint32_t second = build(items, mid, end, depth + 1);
     nodes_[index].offset = second;
     nodes_[index].count = 0;
-    nodes_[index].axis = static_cast<std::uint8_t>(axis);
     return index;
 }
 
-std::uint32_t Bvh::median_split(std::uint32_t begin, std::uint32_t end, int axis) {
-    const std::uint32_t mid = begin + (end - begin) / 2;
-    std::nth_element(primitives_.begin() + begin, primitives_.begin() + mid,
-                     primitives_.begin() + end, [&](const Primitive& a, const Primitive& b) {
-                         return a.bounds.centre()[axis] < b.bounds.centre()[axis];
-                     });
-    return mid;
+std::optional<double> Bvh::hit_primitive(const Primitive& p, const Ray& ray, double origin_scale,
+                                         Interval range) const {
+    switch (p.kind) {
+        case Kind::kStillSphere:
+            return intersect_sphere(p.centre, p.radius, ray, origin_scale, range);
+        case Kind::kMovingSphere: {
+            if (!p.time.contains(ray.time)) return std::nullopt;
+            // Sphere::centre_at's interpolation, to the bit: the ends exactly, lerp in between.
+            const Motion& m = motions_[p.motion];
+            const double f = ray.time - m.start;
+            const Vec3 centre = f <= 0 ? p.centre : (f >= 1 ? m.end : p.centre + m.delta * f);
+            return intersect_sphere(centre, p.radius, ray, origin_scale, range);
+        }
+        case Kind::kOther:
+            if (!p.time.contains(ray.time)) return std::nullopt;
+            return p.object->intersect(ray, range);
+    }
+    return std::nullopt;
 }
 
 template <bool kAnyHit>
-std::optional<Intersection> Bvh::traverse(const Ray& ray, Interval range) const {
+std::optional<Intersection> Bvh::traverse(const Ray& ray, Interval range,
+                                          const Occluders& occluders) const {
+    const double origin_scale = max_abs_component(ray.origin);
     std::optional<Intersection> nearest;
+    for (std::size_t i = 0; i < planes_.size(); ++i) {
+        if (i < 64 && (occluders.planes >> i & 1) == 0) continue;
+        const PlaneData& plane = planes_[i];
+        if (auto t = intersect_plane(plane.point, plane.normal, plane.point_scale, ray,
+                                     origin_scale, range)) {
+            nearest = Intersection{*t, plane.object};
+            if constexpr (kAnyHit) return nearest;
+            range.max = *t;
+        }
+    }
     for (const Object* object : unbounded_) {
         if (auto t = object->intersect(ray, range)) {
             nearest = Intersection{*t, object};
@@ -135,57 +247,214 @@ std::optional<Intersection> Bvh::traverse(const Ray& ray, Interval range) const 
         }
     }
     if (nodes_.empty()) return nearest;
+    // Tests a leaf's primitives; true when an any-hit query is answered.
+    auto leaf = [&](const Node& node) {
+        for (std::uint32_t i = node.offset; i < node.offset + node.count; ++i) {
+            const Primitive& p = primitives_[i];
+            // Still spheres, the common case, inline; the rest out of line.
+            if (auto t = p.kind == Kind::kStillSphere
+                             ? intersect_sphere(p.centre, p.radius, ray, origin_scale, range)
+                             : hit_primitive(p, ray, origin_scale, range)) {
+                nearest = Intersection{*t, p.object};
+                if constexpr (kAnyHit) return true;
+                range.max = *t;
+            }
+        }
+        return false;
+    };
+    // A few primitives in all (a tree that is one leaf): testing them is cheaper than their box.
+    if (nodes_[0].count > 0) {
+        leaf(nodes_[0]);
+        return nearest;
+    }
 
-    const Vec3 inv_dir{1.0 / ray.dir.x, 1.0 / ray.dir.y, 1.0 / ray.dir.z};
-    const bool negative[3] = {ray.dir.x < 0, ray.dir.y < 0, ray.dir.z < 0};
-    std::array<std::uint32_t, kStackSize> stack;
+    const RayData r(ray);
+    double entry = 0;
+    if (!r.enters(nodes_[0], range.min, range.max, entry)) return nearest;
+    struct Pending {
+        std::uint32_t node;
+        double entry;
+    };
+    std::array<Pending, kStackSize> stack;
     int top = 0;
     std::uint32_t current = 0;
     while (true) {
         const Node& node = nodes_[current];
-        if (node.time.contains(ray.time) &&
-            hits_box(node.bounds, ray.origin, inv_dir, range.min, range.max)) {
-            if (node.count > 0) {
-                for (std::uint32_t i = node.offset; i < node.offset + node.count; ++i) {
-                    const Primitive& p = primitives_[i];
-                    if (!p.time.contains(ray.time)) continue;
-                    if (auto t = p.object->intersect(ray, range)) {
-                        nearest = Intersection{*t, p.object};
-                        if constexpr (kAnyHit) return nearest;
-                        range.max = *t;
-                    }
-                }
-            } else {
-                // Visit the child nearer along the split axis first, so hits shrink the range early.
-                const std::uint32_t first = current + 1, second = node.offset;
-                if (negative[node.axis]) {
-                    stack[top++] = first;
-                    current = second;
-                } else {
-                    stack[top++] = second;
-                    current = first;
-                }
+        if (node.count == 0) {
+            // Both children are tested here, and the nearer entered first, so that a hit in it
+            // shrinks the range before the farther one is even opened.
+            const std::uint32_t first = current + 1, second = node.offset;
+            double t_first = 0, t_second = 0;
+            const bool in_first = r.enters(nodes_[first], range.min, range.max, t_first);
+            const bool in_second = r.enters(nodes_[second], range.min, range.max, t_second);
+            if (in_first && in_second) {
+                const bool second_nearer = t_second < t_first;
+                stack[top++] = second_nearer ? Pending{first, t_first} : Pending{second, t_second};
+                current = second_nearer ? second : first;
                 continue;
             }
+            if (in_first || in_second) {
+                current = in_first ? first : second;
+                continue;
+            }
+        } else if (leaf(node)) {
+            return nearest;
         }
-        if (top == 0) break;
-        current = stack[--top];
+        // Next pending node the ray still reaches before the nearest hit so far.
+        do {
+            if (top == 0) return nearest;
+            --top;
+        } while (stack[top].entry > range.max);
+        current = stack[top].node;
     }
-    return nearest;
 }
 
 std::optional<Intersection> Bvh::intersect(const Ray& ray, Interval range) const {
-    return traverse<false>(ray, range);
+    return traverse<false>(ray, range, Occluders{});
 }
 
 bool Bvh::occluded(const Ray& ray, Interval range) const {
-    return traverse<true>(ray, range).has_value();
+    return traverse<true>(ray, range, Occluders{}).has_value();
+}
+
+bool Bvh::occluded(const Ray& ray, Interval range, const Occluders& occluders) const {
+    if (occluders.everything) return traverse<true>(ray, range, occluders).has_value();
+    // Only what was gathered: the planes whose bits are set and the listed primitives.
+    const double origin_scale = max_abs_component(ray.origin);
+    for (std::uint64_t left = occluders.planes; left != 0; left &= left - 1) {
+        const PlaneData& p = planes_[static_cast<std::size_t>(std::countr_zero(left))];
+        if (intersect_plane(p.point, p.normal, p.point_scale, ray, origin_scale, range))
+            return true;
+    }
+    for (std::size_t i = 64; i < planes_.size(); ++i) {
+        const PlaneData& p = planes_[i];
+        if (intersect_plane(p.point, p.normal, p.point_scale, ray, origin_scale, range))
+            return true;
+    }
+    for (const Object* object : unbounded_) {
+        if (object->intersect(ray, range)) return true;
+    }
+    for (int i = 0; i < occluders.count; ++i) {
+        const Primitive& p = primitives_[occluders.primitives[i]];
+        if (p.kind == Kind::kStillSphere
+                ? intersect_sphere(p.centre, p.radius, ray, origin_scale, range).has_value()
+                : hit_primitive(p, ray, origin_scale, range).has_value()) {
+            return true;
+        }
+    }
+    return false;
+}
+
+namespace {
+
+// Slack, relative to the scene's coordinates and to cosines, by which the culling below errs on
+// the side of keeping: far above rounding, far below anything a scene could notice.
+constexpr double kSlack = 1e-9;
+
+// The cone of segments from an apex to the points of a ball, and whether a ball may meet one.
+struct SegmentCone {
+    Vec3 apex, axis;
+    double sin_a, cos_a;  // of its half-angle
+    double reach;         // no segment is longer
+    double slack;         // absolute, for distances
+
+    // Whether some segment may pass through the ball (centre, radius): conservative.
+    bool may_meet(const Vec3& centre, double radius) const {
+        const Vec3 v = centre - apex;
+        const double d2 = dot(v, v);
+        if (d2 <= radius * radius) return true;  // the apex is in it
+        const double r = radius + slack;
+        const double along = dot(v, axis);
+        if (along - r > reach) return false;  // wholly beyond the farthest segment's end
+        // Within the sum of the half-angles a of the cone and b of the ball about the axis:
+        // angle(v, axis) <= a + b, that is along >= |v| cos(a + b) = cos a |v| cos b - sin a r,
+        // where |v| cos b = sqrt(|v|² - r²) (0 when the apex is within the slack of the ball,
+        // which then looks like a half-space: missed when the whole light is above its plane).
+        const double tangent = std::sqrt(std::max(0.0, d2 - r * r));
+        return along >= cos_a * tangent - sin_a * r - kSlack * (tangent + r);
+    }
+};
+
+}  // namespace
+
+Occluders Bvh::gather_occluders(const Vec3& origin, const Ball& target, double time) const {
+    Occluders found;
+    const double slack =
+        kSlack * (max_abs_component(origin) + max_abs_component(target.centre) + target.radius);
+    const Vec3 w = target.centre - origin;
+    const double reach = length(w);
+    // From inside the ball, or next to it, segments go every way: keep everything.
+    if (!(reach > target.radius + slack)) return found;
+    const double sin_a = target.radius / reach;
+    const SegmentCone cone{origin,
+                           w / reach,
+                           sin_a,
+                           std::sqrt(std::max(0.0, 1.0 - sin_a * sin_a)),
+                           reach + target.radius + slack,
+                           slack};
+
+    // A plane can block only if the origin and the ball are not both strictly on one side of it.
+    found.planes = 0;
+    const double origin_scale = max_abs_component(origin);
+    for (std::size_t i = 0; i < planes_.size() && i < 64; ++i) {
+        const PlaneData& p = planes_[i];
+        // The origin may be as close as a spawned ray's offset, far above rounding; the ball is
+        // held to the coarser slack.
+        const double near = 1e-12 * (origin_scale + p.point_scale);
+        const double margin = slack + kSlack * p.point_scale;
+        const double from = dot(origin, p.normal) - p.offset;
+        const double to = dot(target.centre, p.normal) - p.offset;
+        const bool apart = (from > near && to - target.radius > margin) ||
+                           (from < -near && to + target.radius < -margin);
+        if (!apart) found.planes |= std::uint64_t{1} << i;
+    }
+
+    if (nodes_.empty()) {
+        found.everything = false;
+        return found;
+    }
+    std::array<std::uint32_t, kStackSize> stack;
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const Node& node = nodes_[stack[--top]];
+        if (!(node.time_min <= time && time <= node.time_max)) continue;
+        const Vec3 lo{node.box[0], node.box[1], node.box[2]};
+        const Vec3 hi{node.box[3], node.box[4], node.box[5]};
+        // (A tree that is a single leaf goes straight to its few primitives.)
+        if (nodes_.size() > 1 && !cone.may_meet((lo + hi) * 0.5, 0.5 * length(hi - lo))) {
+            continue;
+        }
+        if (node.count == 0) {
+            stack[top++] = node.offset;
+            stack[top++] = static_cast<std::uint32_t>(&node - nodes_.data()) + 1;
+            continue;
+        }
+        for (std::uint32_t i = node.offset; i < node.offset + node.count; ++i) {
+            const Primitive& p = primitives_[i];
+            if (!p.time.contains(time)) continue;
+            bool may_block = true;
+            if (p.kind == Kind::kStillSphere) {
+                may_block = cone.may_meet(p.centre, p.radius);
+            } else if (p.kind == Kind::kMovingSphere) {
+                const Motion& m = motions_[p.motion];
+                const double f = time - m.start;
+                const Vec3 centre = f <= 0 ? p.centre : (f >= 1 ? m.end : p.centre + m.delta * f);
+                may_block = cone.may_meet(centre, p.radius);
+            }
+            if (!may_block) continue;
+            if (found.count == Occluders::kMaxListed) return found;  // too many: traverse instead
+            found.primitives[found.count++] = i;
+        }
+    }
+    found.everything = false;
+    return found;
 }
 
 std::size_t Bvh::depth() const {
     std::size_t deepest = 0;
-    std::vector<std::pair<std::uint32_t, std::size_t>> stack{{0, 1}};
     if (nodes_.empty()) return 0;
+    std::vector<std::pair<std::uint32_t, std::size_t>> stack{{0, 1}};
     while (!stack.empty()) {
         const auto [node, d] = stack.back();
         stack.pop_back();

@@ -1,7 +1,9 @@
 #include "drt/integrator.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <span>
 
 #include "drt/rng.h"
 
@@ -14,6 +16,14 @@ namespace {
 // fallback is taken with probability about 2^-32.
 constexpr int kRedrawAttempts = 32;
 
+// The mirror direction about the shading normal, or about the geometric one when a bump has
+// tilted the shading normal so far that the mirror direction would dive below the surface (as
+// refraction falls back below), so an ideal reflection too leaves on the viewer's side.
+Vec3 reflect_above(const Vec3& d, const Vec3& shading, const Vec3& geometric) {
+    const Vec3 r = reflect(d, shading);
+    return dot(r, geometric) > 0 ? r : reflect(d, geometric);
+}
+
 }  // namespace
 
 Ray spawn_ray(const Vec3& point, const Vec3& normal, const Vec3& dir, double time) {
@@ -25,9 +35,9 @@ Ray spawn_ray(const Vec3& point, const Vec3& normal, const Vec3& dir, double tim
 Vec3 perturb_direction(const Vec3& ideal, double sigma, Vec2 u) {
     // Box-Muller radius: the length of a 2-D normal vector with per-axis deviation sigma.
     const double theta = sigma * std::sqrt(-2.0 * std::log1p(-u.x));
-    const double phi = 2.0 * kPi * u.y;
+    const SinCos phi = sincos_turns(u.y);
     const double sin_t = std::sin(theta);
-    const Vec3 local{sin_t * std::cos(phi), sin_t * std::sin(phi), std::cos(theta)};
+    const Vec3 local{sin_t * phi.cos, sin_t * phi.sin, std::cos(theta)};
     return normalize(Frame::around(ideal).to_world(local));
 }
 
@@ -86,7 +96,7 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth,
 
     const double sigma = m.sigma();
     if (m.reflects()) {
-        const Vec3 ideal = reflect(ray.dir, shading);
+        const Vec3 ideal = reflect_above(ray.dir, shading, geometric);
         result += m.reflective * m.ks *
                   scattered(surface.point, geometric, ideal, sigma, +1, ray.time, s, depth,
                             dim::kGlossReflect, false, counts);
@@ -98,8 +108,9 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth,
         const double fresnel = fresnel_dielectric(cos_i, eta);
         Color glass;
         if (fresnel > 0) {
-            glass += fresnel * scattered(surface.point, geometric, reflect(ray.dir, shading), sigma,
-                                         +1, ray.time, s, depth, dim::kGlassReflect, false, counts);
+            glass += fresnel * scattered(surface.point, geometric,
+                                         reflect_above(ray.dir, shading, geometric), sigma, +1,
+                                         ray.time, s, depth, dim::kGlassReflect, false, counts);
         }
         if (fresnel < 1) {
             auto through = refract(ray.dir, shading, eta);
@@ -144,32 +155,52 @@ Color Integrator::scattered(const Vec3& point, const Vec3& geometric, const Vec3
     return rays == 1 ? sum : sum / rays;
 }
 
-Color Integrator::light_ray(const Light& light, const Vec3& point, const Vec3& geometric,
-                            const Vec3& shading, double time, Vec2 u, RayCounts& counts) const {
-    const LightSample ls = light.sample(point, u);
+Color Integrator::light_ray(const Light& light, const LightSample& ls, const Vec3& origin,
+                            const Vec3& geometric, const Vec3& shading, double time,
+                            const Occluders& occluders, RayCounts& counts) const {
     const double cosine = dot(shading, ls.dir);
     // Light from behind the shading normal or below the surface itself adds nothing; no ray needed.
     if (cosine <= 0 || dot(geometric, ls.dir) <= 0) return {};
     ++counts.shadow;
-    const Ray shadow = spawn_ray(point, geometric, ls.dir, time);
-    if (bvh_.occluded(shadow, {0, ls.distance})) return {};
+    if (bvh_.occluded({origin, ls.dir, time}, {0, ls.distance}, occluders)) return {};
     return light.intensity() * cosine;
 }
 
 Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const Vec3& shading,
                                double time, const PixelSample& s, int depth,
                                RayCounts& counts) const {
+    // Every shadow ray leaves on the geometric normal's side, so from the same spawned origin.
+    const Vec3 origin = spawn_ray(point, geometric, geometric, time).origin;
+    // Points and directions come a chunk at a time, so that what a set shares (its key, the
+    // light's cone) is worked out once rather than once per ray.
+    constexpr int kChunk = 16;
+    std::array<Vec2, kChunk> points;
+    std::array<LightSample, kChunk> samples;
     Color sum;
     for (std::size_t i = 0; i < scene_.lights.size(); ++i) {
         const int rays = plan_.shadow_rays[i];
         if (rays == 0) continue;
         const Light& light = *scene_.lights[i];
         const std::uint32_t dimension = dim::light(depth, i);
+        // What can block this point's rays to this light, found once for all of them when they
+        // are several; a lone ray is as cheap to trace through everything.
+        const Occluders occluders =
+            rays >= 3 ? bvh_.gather_occluders(origin, light.extent(), time) : Occluders{};
         Color light_sum;
-        for (int j = 0; j < rays; ++j) {
-            const Vec2 u = rays == 1 ? sampler_.get_2d(s, dimension)
-                                     : sampler_.get_2d_in_set(s, dimension, j, rays);
-            light_sum += light_ray(light, point, geometric, shading, time, u, counts);
+        for (int first = 0; first < rays; first += kChunk) {
+            const auto n = static_cast<std::size_t>(std::min(kChunk, rays - first));
+            if (rays == 1) {
+                points[0] = sampler_.get_2d(s, dimension);
+            } else {
+                sampler_.get_2d_set(s, dimension, static_cast<std::uint32_t>(rays),
+                                    static_cast<std::uint32_t>(first), std::span(points).first(n));
+            }
+            light.sample(point, std::span<const Vec2>(points).first(n),
+                         std::span(samples).first(n));
+            for (std::size_t j = 0; j < n; ++j) {
+                light_sum += light_ray(light, samples[j], origin, geometric, shading, time,
+                                       occluders, counts);
+            }
         }
         sum += rays == 1 ? light_sum : light_sum / rays;
     }
@@ -187,7 +218,10 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
             const double lo = k == 0 ? 0.0 : cdf[k - 1];
             const double p = cdf[k] - lo;
             u.x = std::clamp((u.x - lo) / p, 0.0, std::nextafter(1.0, 0.0));  // reuse within the pick
-            sum += light_ray(*area_lights_[k], point, geometric, shading, time, u, counts) / (p * rays);
+            const Light& light = *area_lights_[k];
+            sum += light_ray(light, light.sample(point, u), origin, geometric, shading, time,
+                             Occluders{}, counts) /
+                   (p * rays);
         }
     }
     return sum;

@@ -1,7 +1,6 @@
 #include "drt/plane.h"
 
 #include <cmath>
-#include <limits>
 
 namespace drt {
 
@@ -28,17 +27,8 @@ Plane::Plane(Vec3 point, Vec3 normal, const Material& material, SurfaceDetail de
       offset_(dot(frame_.n, point)) {}
 
 std::optional<double> Plane::intersect(const Ray& ray, Interval range) const {
-    const double denom = dot(ray.dir, frame_.n);
-    if (denom == 0) return std::nullopt;
-    double distance = dot(point_ - ray.origin, frame_.n);
-    // An origin on the plane up to rounding (a ray leaving a hit point) is at distance exactly 0,
-    // so the root t = 0 is excluded by a range starting at 0 instead of landing ~1e-16 away.
-    const double on_plane_tolerance = 8.0 * std::numeric_limits<double>::epsilon() *
-                                      (max_abs_component(ray.origin) + max_abs_component(point_));
-    if (std::abs(distance) <= on_plane_tolerance) distance = 0;
-    const double t = distance / denom;
-    if (!range.surrounds(t)) return std::nullopt;
-    return t;
+    return intersect_plane(point_, frame_.n, max_abs_component(point_), ray,
+                           max_abs_component(ray.origin), range);
 }
 
 Vec3 Plane::project_to_surface(const Vec3& p, double) const {

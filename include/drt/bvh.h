@@ -2,8 +2,14 @@
 // sphere enters once per segment of its path, bounded over that segment's time span only, and
 // every node knows the time span of what it holds, so rays skip objects that are elsewhere at
 // their time. Unbounded objects (planes) are tested separately.
+//
+// Spheres and planes, which is all the scene format has, are copied into flat arrays and tested
+// inline with the same arithmetic as Sphere::intersect and Plane::intersect, so a traversal
+// makes no virtual call and chases no pointer; any other kind of object is asked through the
+// Object interface.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -18,39 +24,86 @@ struct Intersection {
     const Object* object;
 };
 
+// What may block the segments from one origin to the points of one ball (a light) at one time:
+// the planes and primitives that meet the cone those segments fill. Bvh::gather_occluders finds
+// them once for a shading point and a light; each of the point's shadow rays then tests only
+// them. The default holds everything, which is always correct.
+struct Occluders {
+    static constexpr int kMaxListed = 16;
+    std::uint64_t planes = ~std::uint64_t{0};  // bit i: plane i may block (from the 65th, all may)
+    bool everything = true;                    // whether to traverse the tree instead of the list
+    int count = 0;
+    std::array<std::uint32_t, kMaxListed> primitives{};
+};
+
 class Bvh {
-public:
+  public:
     explicit Bvh(const std::vector<std::unique_ptr<Object>>& objects);
 
     std::optional<Intersection> intersect(const Ray& ray, Interval range) const;
     // Whether anything blocks the ray within range (any hit will do, so it stops at the first).
     bool occluded(const Ray& ray, Interval range) const;
+    // The same for a ray from `origin` to a point of the ball the occluders were gathered for,
+    // at their time, testing only them.
+    bool occluded(const Ray& ray, Interval range, const Occluders& occluders) const;
+    Occluders gather_occluders(const Vec3& origin, const Ball& target, double time) const;
 
     std::size_t node_count() const { return nodes_.size(); }
     std::size_t depth() const;
 
-private:
-    struct Primitive {
+  private:
+    enum class Kind : std::uint32_t { kStillSphere, kMovingSphere, kOther };
+
+    // One sphere, one segment of a moving sphere's path, or another bounded object.
+    struct alignas(64) Primitive {
+        Vec3 centre;  // a still sphere's centre; a moving one's at the start of its segment
+        double radius;
+        Interval time;  // shutter times at which this piece is where the bounds say
         const Object* object;
-        Bounds bounds;
-        Interval time;
+        Kind kind;
+        std::uint32_t motion;  // index into motions_ for a moving sphere
     };
-    struct Node {
-        Bounds bounds;
-        Interval time;
+    // Where a segment of a moving sphere's path goes: it starts at time `start` at the
+    // primitive's centre and ends one time unit later at `end`.
+    struct Motion {
+        Vec3 delta;  // end - centre
+        Vec3 end;
+        double start;
+    };
+    struct PlaneData {
+        Vec3 point, normal;
+        double point_scale;  // max_abs_component(point)
+        double offset;       // dot(point, normal)
+        const Object* object;
+    };
+    // A node is one cache line: its box, the time span of what it holds (rounded outwards to
+    // float), and its primitives (leaf) or its second child (inner; the first follows it).
+    struct alignas(64) Node {
+        double box[6];  // lo x, y, z then hi x, y, z
+        float time_min, time_max;
         std::uint32_t offset;  // leaf: first primitive; inner: index of the second child
-        std::uint16_t count;   // primitives in a leaf, 0 for an inner node
-        std::uint8_t axis;     // split axis of an inner node, for front-to-back order
+        std::uint32_t count;   // primitives in a leaf, 0 for an inner node
     };
+    struct Build {
+        Bounds bounds;
+        Interval time;
+        std::uint32_t primitive;
+    };
+    struct RayData;
 
-    std::uint32_t build(std::uint32_t begin, std::uint32_t end, int depth);
-    std::uint32_t median_split(std::uint32_t begin, std::uint32_t end, int axis);
+    std::uint32_t build(std::vector<Build>& items, std::uint32_t begin, std::uint32_t end,
+                        int depth);
     template <bool kAnyHit>
-    std::optional<Intersection> traverse(const Ray& ray, Interval range) const;
+    std::optional<Intersection> traverse(const Ray& ray, Interval range,
+                                         const Occluders& occluders) const;
+    std::optional<double> hit_primitive(const Primitive& p, const Ray& ray, double origin_scale,
+                                        Interval range) const;
 
-    std::vector<Primitive> primitives_;
+    std::vector<Primitive> primitives_;  // in leaf order
+    std::vector<Motion> motions_;
     std::vector<Node> nodes_;
-    std::vector<const Object*> unbounded_;
+    std::vector<PlaneData> planes_;
+    std::vector<const Object*> unbounded_;  // unbounded objects other than planes
 };
 
 }  // namespace drt

@@ -49,8 +49,10 @@ private:
     // Σ lights at a point: I · max(0, N·ω) · visibility, averaged over each light's shadow rays.
     Color direct_light(const Vec3& point, const Vec3& geometric, const Vec3& shading, double time,
                        const PixelSample& s, int depth, RayCounts& counts) const;
-    Color light_ray(const Light& light, const Vec3& point, const Vec3& geometric,
-                    const Vec3& shading, double time, Vec2 u, RayCounts& counts) const;
+    // One shadow ray from `origin` (spawned off the shading point) along a light sample.
+    Color light_ray(const Light& light, const LightSample& ls, const Vec3& origin,
+                    const Vec3& geometric, const Vec3& shading, double time,
+                    const Occluders& occluders, RayCounts& counts) const;
     // Average radiance along `rays` directions about `ideal` (one exactly ideal ray if sigma is
     // 0), each redrawn until it leaves on the `side` of the surface (+1 = the normal's side).
     Color scattered(const Vec3& point, const Vec3& geometric, const Vec3& ideal, double sigma,

@@ -1,7 +1,10 @@
 // Lights: spheres of uniform radiance (the thesis's round lights) and their limit, the point light.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <optional>
+#include <span>
 
 #include "drt/color.h"
 #include "drt/math.h"
@@ -16,7 +19,7 @@ struct LightSample {
 };
 
 class Light {
-public:
+  public:
     explicit Light(Color intensity, bool visible) : intensity_(intensity), visible_(visible) {}
     virtual ~Light() = default;
 
@@ -24,6 +27,12 @@ public:
     // Light reaching x is intensity() * max(0, N·dir) * visibility, averaged over such samples:
     // that is the contract's I·(1/Ω)∫cap max(0, N·ω) V dω, estimated with pdf 1/Ω.
     virtual LightSample sample(const Vec3& x, Vec2 u) const = 0;
+    // sample(x, u[i]) for every i, into out[i]: a light can work out what the samples of one
+    // shading point share (for a sphere, the cone it subtends) only once. Same results.
+    virtual void sample(const Vec3& x, std::span<const Vec2> u, std::span<LightSample> out) const;
+    // A ball holding every point sample() aims at from outside it, so that what can block the
+    // shadow rays of a shading point can be found once for all of them (Bvh::gather_occluders).
+    virtual Ball extent() const = 0;
     // A point light needs exactly one shadow ray; an area light's penumbra needs many.
     virtual bool is_point() const = 0;
     // Distance along `ray` at which it enters the light, for lights visible to rays.
@@ -34,41 +43,52 @@ public:
     // What Cook shares shadow rays by.
     double power() const { return luminance(intensity_); }
 
-private:
+  private:
     Color intensity_;
     bool visible_;
 };
 
 class PointLight final : public Light {
-public:
+  public:
     PointLight(Vec3 position, Color intensity) : Light(intensity, false), position_(position) {}
+    using Light::sample;
     LightSample sample(const Vec3& x, Vec2 u) const override;
+    Ball extent() const override { return {position_, 0}; }
     bool is_point() const override { return true; }
     std::optional<double> intersect(const Ray&, Interval) const override { return std::nullopt; }
 
-private:
+  private:
     Vec3 position_;
 };
 
 class SphereLight final : public Light {
-public:
+  public:
     SphereLight(Vec3 centre, double radius, Color intensity, bool visible)
         : Light(intensity, visible), centre_(centre), radius_(radius) {}
     // Uniform over the cone of directions the sphere subtends from x; from inside or on the
     // sphere, where that cone is ill-defined, uniform over all directions.
     LightSample sample(const Vec3& x, Vec2 u) const override;
+    void sample(const Vec3& x, std::span<const Vec2> u, std::span<LightSample> out) const override;
+    Ball extent() const override { return {centre_, radius_}; }
     bool is_point() const override { return false; }
     std::optional<double> intersect(const Ray& ray, Interval range) const override;
 
     const Vec3& centre() const { return centre_; }
     double radius() const { return radius_; }
 
-private:
+  private:
     Vec3 centre_;
     double radius_;
 };
 
-// Uniformly distributed direction in the cone of half-angle acos(cos_max) about +z.
-Vec3 sample_cone(Vec2 u, double cos_max);
+// Uniformly distributed direction in the cone of half-angle acos(cos_max) about +z. Inline: one
+// per shadow ray.
+inline Vec3 sample_cone(Vec2 u, double cos_max) {
+    // Uniform in solid angle means uniform in cos(theta) between cos_max and 1.
+    const double cos_t = 1.0 - u.x * (1.0 - cos_max);
+    const double sin_t = std::sqrt(std::max(0.0, 1.0 - cos_t * cos_t));
+    const SinCos phi = sincos_turns(u.y);
+    return {sin_t * phi.cos, sin_t * phi.sin, cos_t};
+}
 
 }  // namespace drt

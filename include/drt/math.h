@@ -2,7 +2,9 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 namespace drt {
@@ -56,6 +58,54 @@ inline double max_abs_component(const Vec3& v) {
     return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
 }
 
+struct SinCos {
+    double sin, cos;
+};
+
+// sin and cos of an angle a in [-π/4, π/4], within an ulp or two: the Taylor series in x = a²
+// up to the first term below 1e-16 (a^15 for sin, a^16 for cos), summed by Estrin's scheme,
+// pairs and then pairs of pairs, so that its terms need not wait on one another.
+constexpr SinCos sincos_eighth(double a) {
+    const double x = a * a, x2 = x * x, x4 = x2 * x2;
+    const double sin_series =
+        (1 - x * (1.0 / 6)) + x2 * (1.0 / 120 - x * (1.0 / 5040)) +
+        x4 * ((1.0 / 362880 - x * (1.0 / 39916800)) +
+              x2 * (1.0 / 6227020800 - x * (1.0 / 1307674368000)));
+    const double cos_series =
+        (1 - x * 0.5) + x2 * (1.0 / 24 - x * (1.0 / 720)) +
+        x4 * ((1.0 / 40320 - x * (1.0 / 3628800)) +
+              x2 * (1.0 / 479001600 - x * (1.0 / 87178291200)) + x4 * (1.0 / 20922789888000));
+    return {a * sin_series, cos_series};
+}
+
+// An angle 2π·turns, turns in [0, 1], as q quarter turns (0 .. 4) plus a in [-π/4, π/4].
+struct QuarterTurns {
+    int q;
+    double a;
+};
+constexpr QuarterTurns quarter_turns(double turns) {
+    const double quarters = turns * 4;
+    const auto q = static_cast<int>(quarters + 0.5);
+    return {q, (quarters - q) * (kPi / 2)};
+}
+
+// sin and cos of the angle 2π·turns, within an ulp or two, for turns in [0, 1] (exact at
+// multiples of a quarter turn). Sampling takes one per glossy ray, and std::sin and std::cos,
+// built for any argument, cost several times as much.
+constexpr SinCos sincos_turns(double turns) {
+    const auto [q, a] = quarter_turns(turns);
+    // Rotating by q quarter turns swaps the two for odd q and flips their signs by (q & 2) and
+    // ((q + 1) & 2); done on the bits, because a branch on a random quadrant is mispredicted
+    // three times in four.
+    const SinCos r = sincos_eighth(a);
+    const std::uint64_t s = std::bit_cast<std::uint64_t>(r.sin);
+    const std::uint64_t c = std::bit_cast<std::uint64_t>(r.cos);
+    const std::uint64_t odd = 0 - static_cast<std::uint64_t>(q & 1);  // all ones for odd q
+    const auto sign = [](int bit) { return static_cast<std::uint64_t>(bit & 2) << 62; };
+    return {std::bit_cast<double>(((s & ~odd) | (c & odd)) ^ sign(q)),
+            std::bit_cast<double>(((c & ~odd) | (s & odd)) ^ sign(q + 1))};
+}
+
 // Mirror direction of d about the normal n (both unit length).
 constexpr Vec3 reflect(const Vec3& d, const Vec3& n) { return d - n * (2.0 * dot(d, n)); }
 
@@ -75,6 +125,12 @@ struct Interval {
     double min = 0, max = kInfinity;
     constexpr bool contains(double v) const { return min <= v && v <= max; }
     constexpr bool surrounds(double v) const { return min < v && v < max; }
+};
+
+// A solid sphere, as a region of space (the extent of a light, the bound of a box).
+struct Ball {
+    Vec3 centre;
+    double radius = 0;
 };
 
 // Axis-aligned box; the default is empty so that union-growing works from it.

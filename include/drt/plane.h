@@ -1,20 +1,45 @@
 #pragma once
 
+#include <cmath>
+#include <limits>
+#include <optional>
+
 #include "drt/object.h"
 
 namespace drt {
 
+// Ray parameter inside `range` where the ray meets the plane through `point` with unit normal
+// `normal`. `point_scale` and `origin_scale` are max_abs_component of the point and of the ray's
+// origin, which a caller testing many planes or rays works out once. Inline because the BVH runs
+// it for every plane and every ray.
+inline std::optional<double> intersect_plane(const Vec3& point, const Vec3& normal,
+                                             double point_scale, const Ray& ray,
+                                             double origin_scale, Interval range) {
+    const double denom = dot(ray.dir, normal);
+    if (denom == 0) return std::nullopt;
+    double distance = dot(point - ray.origin, normal);
+    // An origin on the plane up to rounding (a ray leaving a hit point) is at distance exactly 0,
+    // so the root t = 0 is excluded by a range starting at 0 instead of landing ~1e-16 away.
+    const double on_plane_tolerance =
+        8.0 * std::numeric_limits<double>::epsilon() * (origin_scale + point_scale);
+    if (std::abs(distance) <= on_plane_tolerance) distance = 0;
+    const double t = distance / denom;
+    if (!range.surrounds(t)) return std::nullopt;
+    return t;
+}
+
 // An infinite plane through `point` with unit normal `normal`.
 class Plane final : public Object {
-public:
+  public:
     Plane(Vec3 point, Vec3 normal, const Material& material, SurfaceDetail detail = {});
 
     std::optional<double> intersect(const Ray& ray, Interval range) const override;
     std::vector<TimedBounds> motion_bounds() const override { return {}; }
 
     const Vec3& normal() const { return frame_.n; }
+    const Vec3& point() const { return point_; }
 
-protected:
+  protected:
     Vec3 project_to_surface(const Vec3& p, double time) const override;
     Vec3 outward_normal(const Vec3&, double) const override { return frame_.n; }
     // The plane's own 2-D coordinates (about the world origin's projection), so a checker on a
@@ -22,7 +47,7 @@ protected:
     Vec3 texture_point(const Vec3& point, double time) const override;
     Vec3 bump_point(const Vec3& point, double) const override { return point; }
 
-private:
+  private:
     Vec3 point_;
     Frame frame_;
     double offset_;  // dot(normal, point)

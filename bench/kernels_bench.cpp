@@ -1,0 +1,120 @@
+// Micro-benchmarks of the kernels every ray runs through: ray-sphere and ray-plane tests, the
+// samplers' points and the spherical light's direction sampling.
+#include <benchmark/benchmark.h>
+
+#include <array>
+
+#include "bench_world.h"
+#include "drt/light.h"
+#include "drt/plane.h"
+#include "drt/sampler.h"
+
+namespace drt::bench {
+namespace {
+
+constexpr int kRays = 4096;  // cycled through, so the branch predictor cannot learn one ray
+
+void BM_RaySphere(benchmark::State& state) {
+    const RaySet set(kRays, false);
+    const Vec3 centre{500, 500, 500};
+    std::size_t i = 0, hits = 0;
+    for (auto _ : state) {
+        const auto t = intersect_sphere(centre, 200, set.rays[i], {0, kInfinity});
+        hits += t.has_value();
+        benchmark::DoNotOptimize(t);
+        i = (i + 1) % kRays;
+    }
+    state.counters["hit_fraction"] = double(hits) / double(state.iterations());
+}
+BENCHMARK(BM_RaySphere);
+
+void BM_RayPlane(benchmark::State& state) {
+    const RaySet set(kRays, false);
+    Material material;
+    const Plane plane({0, 500, 0}, {0, 1, 0}, material);
+    std::size_t i = 0;
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(plane.intersect(set.rays[i], {0, kInfinity}));
+        i = (i + 1) % kRays;
+    }
+}
+BENCHMARK(BM_RayPlane);
+
+// A pixel's camera sample in 2-D (the antialiasing jitter), for each sampler.
+void BM_Sample2d(benchmark::State& state, const char* name) {
+    const auto sampler = make_sampler(name);
+    PixelSample s{0, 0, 0, 100};
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(sampler->get_2d(s, dim::kPixel));
+        s.index = (s.index + 1) % s.count;
+        s.pixel += s.index == 0;
+    }
+}
+BENCHMARK_CAPTURE(BM_Sample2d, random, "random");
+BENCHMARK_CAPTURE(BM_Sample2d, stratified, "stratified");
+
+// The points of one shading point's shadow-ray set (k = range(0) points), per point.
+void BM_SampleSet(benchmark::State& state, const char* name) {
+    const auto sampler = make_sampler(name);
+    const auto k = static_cast<std::uint32_t>(state.range(0));
+    PixelSample s{0, 0, 0, 100};
+    for (auto _ : state) {
+        for (std::uint32_t j = 0; j < k; ++j) {
+            benchmark::DoNotOptimize(sampler->get_2d_in_set(s, dim::light(0, 0), j, k));
+        }
+        s.index = (s.index + 1) % s.count;
+        s.pixel += s.index == 0;
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * k));
+}
+BENCHMARK_CAPTURE(BM_SampleSet, stratified, "stratified")->Arg(5)->Arg(9);
+BENCHMARK_CAPTURE(BM_SampleSet, random, "random")->Arg(5)->Arg(9);
+
+// The same set at once, as the integrator asks for it.
+void BM_SampleSetBatch(benchmark::State& state, const char* name) {
+    const auto sampler = make_sampler(name);
+    const auto k = static_cast<std::uint32_t>(state.range(0));
+    std::array<Vec2, 64> points;
+    PixelSample s{0, 0, 0, 100};
+    for (auto _ : state) {
+        sampler->get_2d_set(s, dim::light(0, 0), k, 0, std::span(points).first(k));
+        benchmark::DoNotOptimize(points);
+        s.index = (s.index + 1) % s.count;
+        s.pixel += s.index == 0;
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * k));
+}
+BENCHMARK_CAPTURE(BM_SampleSetBatch, stratified, "stratified")->Arg(5)->Arg(9);
+BENCHMARK_CAPTURE(BM_SampleSetBatch, random, "random")->Arg(5)->Arg(9);
+
+// A direction towards a spherical light from a point outside it, as for every shadow ray.
+void BM_SphereLightSample(benchmark::State& state) {
+    const SphereLight light({250, 520, 300}, 40, {0.6, 0.6, 0.6}, false);
+    std::size_t i = 0;
+    for (auto _ : state) {
+        const Vec3 x = point_in_cube(6, i % kRays, 400);
+        benchmark::DoNotOptimize(light.sample(x, {unit(7, i), unit(8, i)}));
+        ++i;
+    }
+}
+BENCHMARK(BM_SphereLightSample);
+
+// Nine directions from one point at once, as for one light's shadow rays at a shading point.
+void BM_SphereLightSampleBatch(benchmark::State& state) {
+    const SphereLight light({250, 520, 300}, 40, {0.6, 0.6, 0.6}, false);
+    std::array<Vec2, 9> u;
+    std::array<LightSample, 9> out;
+    std::size_t i = 0;
+    for (auto _ : state) {
+        const Vec3 x = point_in_cube(6, i % kRays, 400);
+        for (std::size_t j = 0; j < u.size(); ++j) u[j] = {unit(7, 9 * i + j), unit(8, 9 * i + j)};
+        light.sample(x, u, out);
+        benchmark::DoNotOptimize(out);
+        ++i;
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * u.size()));
+}
+BENCHMARK(BM_SphereLightSampleBatch);
+
+}  // namespace
+}  // namespace drt::bench

@@ -1,0 +1,280 @@
+// The BVH and the shadow-ray shortcuts against brute force: nearest hits and any-hit answers
+// must be exactly those of testing every object, and the occluders gathered for a light must
+// never change an answer. Also the fast kernels those rays use: quarter-turn sines and batched
+// light samples.
+#include "drt/bvh.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "drt/integrator.h"
+#include "drt/light.h"
+#include "drt/plane.h"
+#include "drt/rng.h"
+#include "drt/sampler.h"
+#include "drt/sphere.h"
+
+namespace drt {
+namespace {
+
+double unit(std::uint64_t stream, std::uint64_t i) {
+    return to_unit(hash_of(stream, i));
+}
+Vec3 point_in(std::uint64_t stream, std::uint64_t i, double lo, double hi) {
+    return {lo + (hi - lo) * unit(stream, 3 * i), lo + (hi - lo) * unit(stream, 3 * i + 1),
+            lo + (hi - lo) * unit(stream, 3 * i + 2)};
+}
+Vec3 direction(std::uint64_t stream, std::uint64_t i) {
+    const double z = 1 - 2 * unit(stream, 2 * i);
+    const double phi = 2 * kPi * unit(stream, 2 * i + 1);
+    const double s = std::sqrt(1 - z * z);
+    return {s * std::cos(phi), s * std::sin(phi), z};
+}
+
+// A room of planes around spheres, some of them moving along paths of one or two segments.
+struct World {
+    Material material;
+    std::vector<std::unique_ptr<Object>> objects;
+
+    World(int spheres, std::uint64_t seed) {
+        material.diffuse = 1;
+        objects.push_back(std::make_unique<Plane>(Vec3{0, 0, 0}, Vec3{0, 1, 0}, material));
+        objects.push_back(std::make_unique<Plane>(Vec3{0, 100, 0}, Vec3{0, -1, 0}, material));
+        objects.push_back(std::make_unique<Plane>(Vec3{-5, 0, 0}, Vec3{1, 0.2, 0}, material));
+        for (int i = 0; i < spheres; ++i) {
+            std::vector<Vec3> path{point_in(seed, i, 5, 95)};
+            const int segments = i % 3;  // still, one segment, two segments
+            for (int k = 0; k < segments; ++k)
+                path.push_back(path.back() + point_in(seed + 1, 3 * i + k, -6, 6));
+            objects.push_back(
+                std::make_unique<Sphere>(std::move(path), 1 + 6 * unit(seed + 2, i), material));
+        }
+    }
+
+    std::optional<Intersection> brute_nearest(const Ray& ray, Interval range) const {
+        std::optional<Intersection> nearest;
+        for (const auto& object : objects) {
+            if (auto t = object->intersect(ray, range)) {
+                nearest = Intersection{*t, object.get()};
+                range.max = *t;
+            }
+        }
+        return nearest;
+    }
+    bool brute_occluded(const Ray& ray, Interval range) const {
+        for (const auto& object : objects) {
+            if (object->intersect(ray, range)) return true;
+        }
+        return false;
+    }
+};
+
+TEST(Bvh, NearestHitIsThatOfTestingEveryObject) {
+    for (const int count : {1, 3, 40, 600}) {
+        const World world(count, 11);
+        const Bvh bvh(world.objects);
+        int hits = 0;
+        for (std::uint64_t i = 0; i < 3000; ++i) {
+            const Ray ray{point_in(20, i, -20, 120), direction(21, i), 2.5 * unit(22, i)};
+            const auto expected = world.brute_nearest(ray, {0, kInfinity});
+            const auto got = bvh.intersect(ray, {0, kInfinity});
+            ASSERT_EQ(got.has_value(), expected.has_value()) << count << " ray " << i;
+            if (!got) continue;
+            ++hits;
+            EXPECT_EQ(got->t, expected->t) << count << " ray " << i;
+            EXPECT_EQ(got->object, expected->object) << count << " ray " << i;
+        }
+        EXPECT_GT(hits, 1000) << count;
+    }
+}
+
+TEST(Bvh, AnyHitIsThatOfTestingEveryObject) {
+    for (const int count : {1, 40, 600}) {
+        const World world(count, 12);
+        const Bvh bvh(world.objects);
+        int blocked = 0;
+        for (std::uint64_t i = 0; i < 3000; ++i) {
+            const Ray ray{point_in(30, i, 1, 99), direction(31, i), 2.5 * unit(32, i)};
+            const Interval range{0, 60 * unit(33, i)};
+            const bool expected = world.brute_occluded(ray, range);
+            ASSERT_EQ(bvh.occluded(ray, range), expected) << count << " ray " << i;
+            blocked += expected;
+        }
+        EXPECT_GT(blocked, 300) << count;
+        EXPECT_LT(blocked, 2900) << count;
+    }
+}
+
+TEST(Bvh, AxisParallelRaysAndRaysAlongSlabPlanesFindTheirHits) {
+    Material material;
+    std::vector<std::unique_ptr<Object>> objects;
+    for (int i = 0; i < 8; ++i) {
+        objects.push_back(
+            std::make_unique<Sphere>(std::vector<Vec3>{{10.0 * i, 0, 0}}, 1.0, material));
+    }
+    const Bvh bvh(objects);
+    // Along +x and -x (directions with zero and negative-zero components), from the middle of
+    // the row, and along the top of the spheres' boxes.
+    for (const Vec3 dir : {Vec3{1, 0, 0}, Vec3{-1, 0, 0}, Vec3{1, -0.0, -0.0}, Vec3{-1, -0.0, 0}}) {
+        const auto hit = bvh.intersect({{35, 0, 0}, dir, 0}, {0, kInfinity});
+        ASSERT_TRUE(hit);
+        EXPECT_DOUBLE_EQ(hit->t, 4.0);
+    }
+    EXPECT_FALSE(bvh.intersect({{-5, 1.5, 0}, {1, 0, 0}, 0}, {0, kInfinity}));
+    const auto top = bvh.intersect({{20, 5, 0}, {0, -1, 0}, 0}, {0, kInfinity});
+    ASSERT_TRUE(top);
+    EXPECT_DOUBLE_EQ(top->t, 4.0);
+}
+
+TEST(Bvh, MovingSphereIsHitOnlyWhereItIsAtTheRaysTime) {
+    Material material;
+    std::vector<std::unique_ptr<Object>> objects;
+    // Present at x = 0, one time unit ago at x = 10, two ago at x = 20.
+    objects.push_back(std::make_unique<Sphere>(std::vector<Vec3>{{0, 0, 0}, {10, 0, 0}, {20, 0, 0}},
+                                               1.0, material));
+    const Bvh bvh(objects);
+    for (const double time : {0.0, 0.5, 1.0, 1.25, 2.0, 3.0}) {
+        const double x = 10 * std::min(time, 2.0);
+        const auto hit = bvh.intersect({{x, 0, -10}, {0, 0, 1}, time}, {0, kInfinity});
+        ASSERT_TRUE(hit) << time;
+        EXPECT_NEAR(hit->t, 9.0, 1e-12) << time;
+        EXPECT_FALSE(bvh.occluded({{x + 3, 0, -10}, {0, 0, 1}, time}, {0, kInfinity})) << time;
+    }
+}
+
+// Shadow rays from points on and off the surfaces to points of a light: the gathered occluders
+// must give exactly the answer of the whole scene, from a floor point, a sphere's surface, a
+// point in free space, and with more spheres in the way than the list holds.
+TEST(Bvh, GatheredOccludersNeverChangeAShadowRaysAnswer) {
+    for (const int count : {2, 12, 200}) {
+        const World world(count, 40 + count);
+        const Bvh bvh(world.objects);
+        int gathered = 0, blocked = 0, rays = 0;
+        for (std::uint64_t p = 0; p < 300; ++p) {
+            const double time = 2.5 * unit(41, p);
+            const Ball light{point_in(42, p, 10, 90), 2 + 10 * unit(43, p)};
+            Vec3 point = point_in(44, p, 5, 95), normal = direction(45, p);
+            if (p % 3 == 0) point.y = 0, normal = {0, 1, 0};  // on the floor
+            if (p % 3 == 1) {
+                // On a sphere (at the ray's time), as a hit point would be.
+                const auto* sphere =
+                    dynamic_cast<const Sphere*>(world.objects[3 + p % count].get());
+                normal = direction(46, p);
+                point = sphere->centre_at(time) + normal * sphere->radius();
+            }
+            const Ray leaving = spawn_ray(point, normal, normal, time);
+            const Occluders occluders = bvh.gather_occluders(leaving.origin, light, time);
+            gathered += !occluders.everything;
+            for (std::uint64_t j = 0; j < 40; ++j) {
+                const Vec3 target = light.centre + direction(47, p * 40 + j) *
+                                                       (light.radius * unit(48, p * 40 + j));
+                const Vec3 d = target - leaving.origin;
+                const Ray ray{leaving.origin, d / length(d), time};
+                if (dot(ray.dir, normal) <= 0) continue;  // shadow rays leave above the surface
+                const Interval range{0, length(d)};
+                const bool expected = bvh.occluded(ray, range);
+                ASSERT_EQ(bvh.occluded(ray, range, occluders), expected)
+                    << count << " point " << p << " ray " << j;
+                blocked += expected, ++rays;
+            }
+        }
+        // Both answers occur (few with two spheres in a large room), and the lists are used.
+        EXPECT_GT(blocked, count < 10 ? 5 : rays / 50) << count;
+        EXPECT_LT(blocked, rays - rays / 50) << count;
+        if (count <= 12) {
+            EXPECT_GT(gathered, 150) << count;
+        }
+    }
+}
+
+TEST(Bvh, FromInsideTheLightEverythingIsKept) {
+    const World world(5, 3);
+    const Bvh bvh(world.objects);
+    const Occluders inside = bvh.gather_occluders({50, 50, 50}, {{50, 52, 50}, 5}, 0);
+    EXPECT_TRUE(inside.everything);
+    EXPECT_EQ(inside.planes, ~std::uint64_t{0});
+    // Far from every plane and sphere, towards a light in open space, nothing needs testing.
+    Material material;
+    std::vector<std::unique_ptr<Object>> objects;
+    objects.push_back(std::make_unique<Plane>(Vec3{0, 0, 0}, Vec3{0, 1, 0}, material));
+    objects.push_back(std::make_unique<Sphere>(std::vector<Vec3>{{100, 10, 0}}, 5.0, material));
+    const Bvh room(objects);
+    const Occluders none = room.gather_occluders({0, 10, 0}, {{0, 50, 0}, 5}, 0);
+    EXPECT_FALSE(none.everything);
+    EXPECT_EQ(none.planes, 0u);
+    EXPECT_EQ(none.count, 0);
+}
+
+TEST(FastKernels, SinCosOfTurnsIsWithinTwoUlpsAndExactAtQuarters) {
+    double worst = 0;
+    for (int i = 0; i <= 100000; ++i) {
+        const double turns = i / 100000.0;
+        const SinCos r = sincos_turns(turns);
+        const long double angle = 2 * 3.141592653589793238462643383279502884L * turns;
+        worst = std::max({worst, std::abs(double(r.sin - std::sin(angle))),
+                          std::abs(double(r.cos - std::cos(angle)))});
+    }
+    EXPECT_LT(worst, 4.5e-16);
+    EXPECT_EQ(sincos_turns(0).sin, 0.0);
+    EXPECT_EQ(sincos_turns(0).cos, 1.0);
+    EXPECT_EQ(sincos_turns(0.25).sin, 1.0);
+    EXPECT_EQ(sincos_turns(0.5).cos, -1.0);
+    EXPECT_EQ(sincos_turns(0.75).sin, -1.0);
+    EXPECT_EQ(sincos_turns(1).cos, 1.0);
+}
+
+TEST(FastKernels, BatchedLightSamplesEqualSingleOnesAndReachTheSphere) {
+    const SphereLight light({3, 40, -7}, 6, {1, 1, 1}, false);
+    for (const Vec3 x : {Vec3{0, 0, 0}, Vec3{3, 30, -7}, Vec3{1e4, -2e3, 5e3}, Vec3{4, 41, -6}}) {
+        std::vector<Vec2> u;
+        for (std::uint64_t i = 0; i < 64; ++i) u.push_back({unit(50, i), unit(51, i)});
+        std::vector<LightSample> batch(u.size());
+        light.sample(x, u, batch);
+        const bool inside = length(x - light.centre()) < light.radius();
+        for (std::size_t i = 0; i < u.size(); ++i) {
+            const LightSample one = light.sample(x, u[i]);
+            EXPECT_EQ(one.dir, batch[i].dir);
+            EXPECT_EQ(one.distance, batch[i].distance);
+            EXPECT_NEAR(length(one.dir), 1.0, 1e-14);
+            const Vec3 on = x + one.dir * one.distance;
+            const double scale = 1e-9 * (length(x) + 50);
+            EXPECT_NEAR(length(on - light.centre()), light.radius(), scale) << i;
+            if (!inside) {
+                // From outside, the near side: nothing of the sphere is closer along the ray.
+                const auto t =
+                    intersect_sphere(light.centre(), light.radius(), {x, one.dir, 0}, {});
+                if (t) {
+                    EXPECT_NEAR(*t, one.distance, scale) << i;
+                }
+            }
+        }
+    }
+}
+
+// Each point of a stratified set, over many keys, is uniform on the square, whatever its index.
+TEST(FastKernels, EveryPointOfAMultiJitteredSetIsUniform) {
+    for (const std::uint32_t k : {2u, 5u, 9u, 10u}) {
+        for (const std::uint32_t j : {0u, k - 1}) {
+            const int bins = 4, n = 64000;
+            std::vector<int> histogram(bins * bins, 0);
+            for (std::uint32_t key = 0; key < n; ++key) {
+                Vec2 p;
+                multi_jittered_set(j, k, static_cast<std::uint32_t>(mix64(key)), {&p, 1});
+                ASSERT_TRUE(p.x >= 0 && p.x < 1 && p.y >= 0 && p.y < 1);
+                ++histogram[static_cast<int>(p.x * bins) * bins + static_cast<int>(p.y * bins)];
+            }
+            for (const int h : histogram) {
+                // 4000 expected, standard deviation 61.
+                EXPECT_NEAR(h, n / (bins * bins), 300) << "k " << k << " j " << j;
+            }
+        }
+    }
+}
+
+}  // namespace
+}  // namespace drt
