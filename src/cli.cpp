@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "drt/compare.h"
+#include "drt/converge.h"
 #include "drt/image.h"
 #include "drt/render_plan.h"
 #include "drt/renderer.h"
@@ -56,7 +57,7 @@ struct Overrides {
             ->check(CLI::PositiveNumber);
         app.add_option("--max-depth", max_depth, "Overrides Render MaxDepth")
             ->check(CLI::NonNegativeNumber);
-        app.add_option("--sampler", sampler, "Sampler: random or stratified (default)")
+        app.add_option("--sampler", sampler, "Sampler: stratified (default), random or sobol")
             ->check(CLI::IsMember(sampler_names()));
     }
 
@@ -141,7 +142,13 @@ std::string stats_json(const Scene& scene, const RenderResult& r) {
       << ", \"total\": " << rays.total() << "},\n"
       << "  \"million_rays_per_second\": "
       << (r.stats.seconds > 0 ? rays.total() / r.stats.seconds / 1e6 : 0.0) << ",\n"
-      << "  \"effects\": {\"antialiasing\": " << json_bool(e.antialiasing)
+      << "  \"mean_spp\": " << double(r.stats.samples) / (double(s.width) * s.height) << ",\n";
+    if (const auto& a = r.stats.adaptive) {
+        j << "  \"adaptive\": {\"noise_threshold\": " << a->noise_threshold
+          << ", \"min_spp\": " << a->min_samples << ", \"max_spp\": " << s.samples
+          << ", \"pixels_converged\": " << r.stats.pixels_converged << "},\n";
+    }
+    j << "  \"effects\": {\"antialiasing\": " << json_bool(e.antialiasing)
       << ", \"soft_shadows\": " << json_bool(e.soft_shadows)
       << ", \"glossy_reflection\": " << json_bool(e.glossy_reflection)
       << ", \"glossy_refraction\": " << json_bool(e.glossy_refraction)
@@ -176,8 +183,31 @@ struct SceneOutcome {
     std::string json;
 };
 
+// --noise-threshold and --min-spp: adaptive sampling, with --spp (or Render Samples) the maximum.
+struct AdaptiveFlags {
+    std::optional<double> noise_threshold;
+    int min_spp = 16;
+
+    void add_to(CLI::App& app) {
+        CLI::Option* threshold =
+            app.add_option("--noise-threshold", noise_threshold,
+                           "Adaptive sampling: a pixel stops once the standard error of its mean "
+                           "luminance is below X; --spp is the maximum")
+                ->check(CLI::PositiveNumber);
+        app.add_option("--min-spp", min_spp,
+                       "Adaptive sampling: samples every pixel takes first (default 16)")
+            ->check(CLI::PositiveNumber)
+            ->needs(threshold);
+    }
+    std::optional<AdaptiveSampling> settings() const {
+        if (!noise_threshold) return std::nullopt;
+        return AdaptiveSampling{*noise_threshold, min_spp};
+    }
+};
+
 struct RenderJob {
     Overrides overrides;
+    AdaptiveFlags adaptive;
     int threads = 0;
     bool quiet = false;
     bool progress = false;
@@ -195,6 +225,7 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output, c
         job.overrides.apply(scene.settings);
         RenderOptions options;
         options.threads = job.threads;
+        options.adaptive = job.adaptive.settings();
         std::optional<ProgressDisplay> display;
         if (job.progress) {
             display.emplace(err, fs::path(scene_path).filename().string());
@@ -255,7 +286,8 @@ bool is_folder_target(const std::string& output) {
 
 int render_command(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
     CLI::App app{"drt: distributed ray tracer (Cook, Porter & Carpenter 1984).\n"
-                 "Also: drt compare A B [--max-rmse X] [--diff D.png] | drt info SCENE.xml",
+                 "Also: drt compare A B [--max-rmse X] [--diff D.png] | drt info SCENE.xml | "
+                 "drt converge SCENE.xml --spp 1,4,16",
                  "drt"};
     std::vector<std::string> scenes;
     std::string output, stats;
@@ -265,6 +297,7 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
     app.add_option("-o,--output", output,
                    "Output image (.png, .bmp, .pfm); with several scenes, a folder");
     job.overrides.add_to(app);
+    job.adaptive.add_to(app);
     app.add_option("--threads", job.threads, "Worker threads (default: all cores)")
         ->check(CLI::PositiveNumber);
     app.add_option("--stats", stats, "Write render statistics as JSON to FILE (- = stdout)");
@@ -356,26 +389,44 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
         return kBadInput;
     }
     Comparison c;
+    Image image_a, image_b;
     try {
-        const Image image_a = read_image(a);
-        const Image image_b = read_image(b);
+        // Check every name before reading, so a typo costs nothing and writes nothing.
+        const bool linear_a = format_for_path(a) == ImageFormat::kPfm;
+        if (linear_a != (format_for_path(b) == ImageFormat::kPfm)) {
+            // Linear floats against sRGB-encoded bytes would measure the tone curve, not the image.
+            throw ImageError("cannot compare " + (linear_a ? a : b) + " (linear .pfm) with " +
+                             (linear_a ? b : a) + " (8-bit sRGB): convert one first");
+        }
+        if (!diff.empty()) format_for_path(diff);
+        image_a = read_image(a);
+        image_b = read_image(b);
         c = compare_images(image_a, image_b);
-        if (!diff.empty()) write_image(difference_image(image_a, image_b), diff);
     } catch (const ImageError& e) {
         err << "drt compare: " << e.what() << "\n";
         return kBadInput;
     }
     out << std::setprecision(6) << "rmse=" << c.rmse << " psnr=" << c.psnr << " ssim=" << c.ssim
-        << " max=" << c.max_abs << "\n";
-    if (max_rmse && c.rmse > *max_rmse) {
+        << " max=" << c.max_abs << " nonfinite=" << c.nonfinite << "\n";
+    int status = kOk;
+    if (!diff.empty()) {
+        try {
+            write_image(difference_image(image_a, image_b), diff);
+        } catch (const ImageError& e) {
+            err << "drt compare: " << e.what() << "\n";
+            status = kFailed;
+        }
+    }
+    // Written as "not within" so that a NaN error (a NaN pixel) fails instead of passing.
+    if (max_rmse && !(c.rmse <= *max_rmse)) {
         err << "drt compare: rmse " << c.rmse << " exceeds --max-rmse " << *max_rmse << "\n";
-        return kFailed;
+        status = kFailed;
     }
-    if (min_psnr && c.psnr < *min_psnr) {
+    if (min_psnr && !(c.psnr >= *min_psnr)) {
         err << "drt compare: psnr " << c.psnr << " is below --min-psnr " << *min_psnr << "\n";
-        return kFailed;
+        status = kFailed;
     }
-    return kOk;
+    return status;
 }
 
 int info_command(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
@@ -405,6 +456,130 @@ int info_command(int argc, const char* const* argv, std::ostream& out, std::ostr
     return kOk;
 }
 
+int converge_command(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+    CLI::App app{"Render a scene at several sample counts and show how its error against a "
+                 "reference falls with samples and with time",
+                 "drt converge"};
+    std::string scene_path, counts_text = "1,4,16,64,256", reference_path, save_reference, csv;
+    std::optional<int> reference_spp;
+    Overrides overrides;
+    AdaptiveFlags adaptive;
+    int threads = 0;
+    app.add_option("scene", scene_path, "Scene file")->required();
+    overrides.add_to(app);
+    app.remove_option(app.get_option("--spp"));  // here a list, not one count
+    app.add_option("--spp", counts_text, "Comma-separated sample counts (default 1,4,16,64,256)");
+    app.add_option("--reference", reference_path,
+                   "Reference image (.pfm) to measure against; default: render one");
+    app.add_option("--reference-spp", reference_spp,
+                   "Samples of the rendered reference (default 16 x the largest count)")
+        ->check(CLI::PositiveNumber);
+    app.add_option("--save-reference", save_reference, "Write the rendered reference to FILE.pfm");
+    app.add_option("--csv", csv,
+                   "Write spp,seconds,rmse,relmse,mean_spp,cpu_seconds,fitted rows to FILE");
+    adaptive.add_to(app);
+    app.add_option("--threads", threads, "Worker threads (default: all cores)")
+        ->check(CLI::PositiveNumber);
+    std::vector<int> counts;
+    try {
+        app.parse(argc, argv);
+        counts = parse_counts(counts_text);
+        // Only linear floats measure the renderer's error; 8-bit files measure the tone curve.
+        for (const std::string& f : {reference_path, save_reference}) {
+            if (!f.empty() && format_for_path(f) != ImageFormat::kPfm) {
+                throw CLI::ValidationError(f + ": the reference must be a linear .pfm image");
+            }
+        }
+    } catch (const CLI::CallForHelp&) {
+        out << app.help();
+        return kOk;
+    } catch (const CLI::ParseError& e) {
+        err << "drt converge: " << e.what() << "\nRun 'drt converge --help' for usage.\n";
+        return kBadInput;
+    } catch (const std::exception& e) {  // a bad count list or image name
+        err << "drt converge: " << e.what() << "\n";
+        return kBadInput;
+    }
+    try {
+        LoadedScene loaded = load_scene(scene_path);
+        for (const std::string& w : loaded.warnings) err << w << "\n";
+        Scene& scene = loaded.scene;
+        overrides.apply(scene.settings);
+        const RenderSettings& s = scene.settings;
+        RenderOptions options;
+        options.threads = threads;
+        options.adaptive = adaptive.settings();
+
+        out << scene_path << ": " << s.width << "x" << s.height << ", sampler " << s.sampler
+            << ", seed " << s.seed;
+        if (options.adaptive) {
+            out << ", noise threshold " << options.adaptive->noise_threshold << ", min spp "
+                << options.adaptive->min_samples;
+        }
+        out << "\n";
+        Image reference;
+        if (!reference_path.empty()) {
+            reference = read_image(reference_path);
+            if (reference.width != s.width || reference.height != s.height) {
+                throw ImageError(reference_path + ": reference is " +
+                                 std::to_string(reference.width) + "x" +
+                                 std::to_string(reference.height) + ", the render " +
+                                 std::to_string(s.width) + "x" + std::to_string(s.height));
+            }
+            out << "reference: " << reference_path << "\n";
+        } else {
+            const int spp = reference_spp.value_or(default_reference_spp(counts));
+            const std::uint64_t seed = reference_seed(s.seed);
+            out << "reference: " << spp << " spp, seed " << seed
+                << " (seed + 1: its noise is independent of the measured renders) ..."
+                << std::flush;
+            RenderOptions plain = options;
+            plain.adaptive.reset();
+            RenderResult r = render_with(scene, spp, seed, plain);
+            out << " " << std::fixed << std::setprecision(2) << r.stats.seconds << " s\n"
+                << std::defaultfloat;
+            if (!save_reference.empty()) write_image(r.image, save_reference);
+            reference = std::move(r.image);
+        }
+        out << std::setw(8) << "spp" << std::setw(11) << "seconds" << std::setw(13) << "rmse"
+            << std::setw(13) << "relmse" << std::setw(10) << "mean_spp" << std::setw(13)
+            << "cpu_seconds" << "\n";
+        const Convergence c =
+            measure_convergence(scene, counts, reference, options, [&](const ConvergencePoint& p) {
+                out << std::setw(8) << p.spp << std::fixed << std::setprecision(3)
+                    << std::setw(11) << p.seconds << std::defaultfloat << std::setprecision(5)
+                    << std::setw(13) << p.rmse << std::setw(13) << p.relmse
+                    << std::setprecision(4) << std::setw(10) << p.mean_spp << std::fixed
+                    << std::setprecision(3) << std::setw(13) << p.cpu_seconds << std::defaultfloat
+                    << (p.fitted ? "" : "  (pixel centres: not in the slopes)") << "\n"
+                    << std::flush;
+            });
+        const auto slope = [](double v) {
+            if (std::isnan(v)) return std::string("n/a (needs two fitted counts)");
+            std::ostringstream text;
+            text << std::fixed << std::setprecision(3) << v;
+            return text.str();
+        };
+        out << "slope of log RMSE against log samples: " << slope(c.slope_vs_spp) << "\n"
+            << "slope of log RMSE against log seconds: " << slope(c.slope_vs_seconds) << "\n";
+        if (!csv.empty()) {
+            std::string text = convergence_csv(c);
+            text.pop_back();  // write_text_atomically ends the file with its own newline
+            write_text_atomically(csv, text);
+        }
+    } catch (const SceneError& e) {
+        err << e.what() << "\n";
+        return kBadInput;
+    } catch (const ImageError& e) {
+        err << "drt converge: " << e.what() << "\n";
+        return kBadInput;
+    } catch (const std::exception& e) {
+        err << "drt converge: " << scene_path << ": " << e.what() << "\n";
+        return kFailed;
+    }
+    return kOk;
+}
+
 }  // namespace
 
 int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
@@ -413,6 +588,7 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
         // CLI11 takes the program name from argv[0]; hand it "drt compare" and the rest.
         if (command == "compare") return compare_command(argc - 1, argv + 1, out, err);
         if (command == "info") return info_command(argc - 1, argv + 1, out, err);
+        if (command == "converge") return converge_command(argc - 1, argv + 1, out, err);
     }
     return render_command(argc, argv, out, err);
 }

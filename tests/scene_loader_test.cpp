@@ -257,6 +257,7 @@ TEST(SceneLoader, ReadsTheContractExample) {
 
 TEST(SceneLoader, RenderAcceptsASamplerName) {
     EXPECT_EQ(load(in_scene(R"(<Render Sampler="random"/>)")).scene.settings.sampler, "random");
+    EXPECT_EQ(load(in_scene(R"(<Render Sampler="sobol"/>)")).scene.settings.sampler, "sobol");
 }
 
 TEST(SceneLoader, SeedTakesTheFull64BitRange) {
@@ -635,8 +636,8 @@ TEST(SceneLoaderErrors, BothTransmitSpellingsAtOnce) {
 }
 
 TEST(SceneLoaderErrors, UnknownSamplerListsTheKnownOnes) {
-    EXPECT_EQ(body_error(R"(<Render Sampler="sobol"/>)"),
-              "t.xml:2: Render: unknown sampler 'sobol'; known: random, stratified");
+    EXPECT_EQ(body_error(R"(<Render Sampler="halton"/>)"),
+              "t.xml:2: Render: unknown sampler 'halton'; known: random, stratified, sobol");
 }
 
 TEST(SceneLoaderErrors, UnknownTextureEvenWhenDisabled) {

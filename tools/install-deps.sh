@@ -1,9 +1,18 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages drt needs to build and test; does nothing when all are present.
-# Usage: tools/install-deps.sh [extra-package ...]
+# Usage: tools/install-deps.sh [--study] [--bench] [extra-package ...]
+#   --study  also gnuplot-nox, which tools/accuracy-study.sh needs to draw its plots
+#   --bench  also libbenchmark-dev, povray and time, which bench/ needs (docs/performance.md)
 set -euo pipefail
 
-packages=(g++ cmake make pkg-config libtinyxml2-dev libstb-dev libcli11-dev libgtest-dev "$@")
+packages=(g++ cmake make pkg-config libtinyxml2-dev libstb-dev libcli11-dev libgtest-dev)
+for arg in "$@"; do
+    case "$arg" in
+        --study) packages+=(gnuplot-nox) ;;
+        --bench) packages+=(libbenchmark-dev povray time) ;;
+        *) packages+=("$arg") ;;
+    esac
+done
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
