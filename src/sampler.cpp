@@ -76,6 +76,25 @@ constexpr Directions kSobolDirections = [] {
     return v;
 }();
 
+// sobol(i, d) = xor of the direction numbers of i's set bits, tabulated per byte of i: the index
+// shuffle sets high bits, so a loop over bits would run 32 times.
+using ByteTables = std::array<std::array<std::array<std::uint32_t, 256>, 4>, kSobolDimensions>;
+constexpr ByteTables kSobolBytes = [] {
+    ByteTables t{};
+    for (std::size_t d = 0; d < kSobolDimensions; ++d) {
+        for (std::size_t byte = 0; byte < 4; ++byte) {
+            for (std::size_t v = 0; v < 256; ++v) {
+                std::uint32_t x = 0;
+                for (std::size_t b = 0; b < 8; ++b) {
+                    if ((v >> b) & 1u) x ^= kSobolDirections[d][8 * byte + b];
+                }
+                t[d][byte][v] = x;
+            }
+        }
+    }
+    return t;
+}();
+
 constexpr double unit32(std::uint32_t x) { return x * 0x1.0p-32; }
 
 // The keys of one dimension's sequence: an index shuffle and a scramble per coordinate.
@@ -263,10 +282,8 @@ std::uint32_t nested_scramble(std::uint32_t x, std::uint32_t key) {
 
 std::uint32_t sobol(std::uint32_t i, int dimension) {
     if (dimension == 0) return reverse_bits(i);
-    const auto& v = kSobolDirections[static_cast<std::size_t>(dimension)];
-    std::uint32_t x = 0;
-    for (std::size_t b = 0; i != 0; ++b, i >>= 1) x ^= v[b] & (0u - (i & 1u));
-    return x;
+    const auto& t = kSobolBytes[static_cast<std::size_t>(dimension)];
+    return t[0][i & 0xffu] ^ t[1][(i >> 8) & 0xffu] ^ t[2][(i >> 16) & 0xffu] ^ t[3][i >> 24];
 }
 
 double SobolSampler::get_1d(const PixelSample& s, std::uint32_t dim) const {
@@ -284,19 +301,53 @@ Vec2 SobolSampler::get_2d(const PixelSample& s, std::uint32_t dim) const {
     return sobol_point(s.index, sobol_keys(s, dim));
 }
 
+namespace {
+
+// The set of k points of camera sample s.index: from the aligned block of K = k rounded up to a
+// power of two indices that the shuffle sends block s.index of size K to, the points
+// start + (j xor c), j < k. Any such run of 2^m points is an aligned sub-block, so a net. The
+// offset c, drawn per block, varies which K - k points go unused from one camera sample to the
+// next: with c = 0 the same ones would, and the low index bits fix the top digits of a point, so
+// a pixel's sets would all leave the same strata of the light empty.
+struct SobolSet {
+    SobolKeys keys;
+    std::uint32_t start;        // the block's first index
+    std::uint32_t offset;       // c
+    std::uint32_t start_y_rev;  // reverse_bits(sobol(start, 1))
+};
+
+SobolSet sobol_set(const PixelSample& s, std::uint32_t dim, std::uint32_t k) {
+    const SobolKeys keys = sobol_keys(s, dim);
+    const std::uint32_t stride = std::bit_ceil(std::max(k, 1u));
+    const std::uint32_t start = nested_scramble(s.index * stride, keys.shuffle) & ~(stride - 1);
+    // A full hash: a multiplicative one of consecutive starts is itself a low-discrepancy
+    // sequence, correlated with the points' own strata.
+    const auto offset = static_cast<std::uint32_t>(
+        (mix64(std::uint64_t{start} ^ (std::uint64_t{keys.y} << 32)) >> 32) & (stride - 1));
+    return {keys, start, offset, reverse_bits(sobol(start, 1))};
+}
+
+// Point j: the block's start and j xor c have no bit in common, so the Sobol coordinates are
+// those of the start xor those of j xor c, and the y scramble can work on the reversed value.
+Vec2 set_point(const SobolSet& set, std::uint32_t j) {
+    const std::uint32_t low = j ^ set.offset;
+    const std::uint32_t y_rev = set.start_y_rev ^ reverse_bits(sobol(low, 1));
+    return {scrambled_x(set.start | low, set.keys.x),
+            unit32(reverse_bits(flip_by_lower_bits(y_rev, set.keys.y)))};
+}
+
+}  // namespace
+
 Vec2 SobolSampler::get_2d_in_set(const PixelSample& s, std::uint32_t dim, std::uint32_t j,
                                  std::uint32_t k) const {
-    // Sets of a power-of-two stride start on aligned blocks, which the shuffle keeps aligned.
-    const std::uint32_t stride = std::bit_ceil(std::max(k, 1u));
-    return sobol_point(s.index * stride + j, sobol_keys(s, dim));
+    return set_point(sobol_set(s, dim, k), j);
 }
 
 void SobolSampler::get_2d_set(const PixelSample& s, std::uint32_t dim, std::uint32_t k,
                               std::uint32_t first, std::span<Vec2> out) const {
-    const SobolKeys keys = sobol_keys(s, dim);
-    const std::uint32_t start = s.index * std::bit_ceil(std::max(k, 1u)) + first;
+    const SobolSet set = sobol_set(s, dim, k);
     for (std::size_t i = 0; i < out.size(); ++i) {
-        out[i] = sobol_point(start + static_cast<std::uint32_t>(i), keys);
+        out[i] = set_point(set, first + static_cast<std::uint32_t>(i));
     }
 }
 

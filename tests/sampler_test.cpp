@@ -583,6 +583,33 @@ TEST(SamplerSobol, SetsArePowerOfTwoNetsAndRefineAcrossSamples) {
     }
 }
 
+// A set of k < K points leaves K - k points of its block unused. Over a pixel's samples the
+// unused ones must vary, or every set misses the same strata of the light: all points of a
+// pixel's sets together must fill the square evenly, for every set size.
+TEST(SamplerSobol, SetsOfAnySizeTogetherFillThePixelsSquareEvenly) {
+    const SobolSampler sampler;
+    for (const std::uint32_t k : {3u, 5u, 6u, 7u, 10u, 8u}) {
+        for (std::uint32_t pixel = 0; pixel < 4; ++pixel) {
+            std::vector<int> x_strata(8, 0), y_strata(8, 0);
+            const std::uint32_t count = 256;
+            for (std::uint32_t index = 0; index < count; ++index) {
+                for (std::uint32_t j = 0; j < k; ++j) {
+                    const Vec2 p =
+                        sampler.get_2d_in_set({2, pixel, index, count}, dim::light(0, 0), j, k);
+                    ++x_strata[static_cast<int>(p.x * 8)];
+                    ++y_strata[static_cast<int>(p.y * 8)];
+                }
+            }
+            // 32k points per stratum; independent points would spread by sqrt(28k) ~ 5 sqrt(k).
+            const double expected = count * k / 8.0;
+            for (int b = 0; b < 8; ++b) {
+                EXPECT_NEAR(x_strata[b], expected, 0.2 * expected) << "k " << k << " x " << b;
+                EXPECT_NEAR(y_strata[b], expected, 0.2 * expected) << "k " << k << " y " << b;
+            }
+        }
+    }
+}
+
 TEST(SamplerSobol, UniformOverThePixelForAnyCount) {
     const SobolSampler sampler;
     for (const std::uint32_t count : {1u, 3u, 10u, 16u, 100u}) {

@@ -120,6 +120,13 @@ if [ "$plots_only" -eq 0 ]; then
             --reference "$work/ref-test$t.pfm"
     done
 
+    # ... and one full-size render, to check that time grows with the pixel count.
+    log "test1: thesis settings at full size"
+    TIMEFORMAT='%R %U %S'
+    { time "$drt" "$thesis/test1.xml" "${threads[@]}" -q -o "$work/test1-full.png"; } \
+        2>"$work/test1-full.time"
+    unset TIMEFORMAT
+
     # 5. Adaptive sampling against plain sampling with the same sampler on Test1, Test5, Test6.
     for t in 1 5 6; do
         for s in stratified sobol; do
@@ -228,6 +235,9 @@ summary=$work/summary.md
         IFS=, read -r spp wall err rel _ sec _ < <(tail -n 1 "$work/thesis-test$t.csv")
         echo "| test$t | $spp × $sr | $(g3 "$err") | $(g3 "$rel") | $(g3 "$sec") | $(awk -v s="$sec" 'BEGIN { printf "%.0f", s * 64 }') | $(g3 "$wall") |"
     done
+    echo
+    read -r wall user sys <"$work/test1-full.time"
+    echo "Test1 at its full 800x600 with the thesis's settings: $wall s wall-clock, $(awk -v u="$user" -v s="$sys" 'BEGIN { printf "%.1f", u + s }') CPU seconds."
     echo
     echo "## Adaptive sampling (min 16 spp, max 1024) against plain sampling with the same sampler"
     echo

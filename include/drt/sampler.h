@@ -112,9 +112,10 @@ public:
 // (0,2)-sequence is a (0,m,2)-net: one point in every elementary interval of area 2^-m, in
 // particular in every cell of a 2^a x 2^b grid with a + b = m. The shuffle keeps that true of
 // the first 2^m samples, so every power-of-two count is a net and other counts are the first
-// points of the next one. A set of k points within camera sample i takes the points
-// i*K .. i*K+k-1 of the dimension's sequence (K = k rounded up to a power of two), so a set of
-// K is itself a net and the sets of a pixel's samples together refine one another.
+// points of the next one. A set of k points within camera sample i takes the first k points of
+// the aligned block of K indices (K = k rounded up to a power of two) that the shuffle sends
+// indices i*K .. i*K+K-1 to, so a set of K is itself a net and the sets of a pixel's samples
+// together refine one another.
 class SobolSampler final : public Sampler {
 public:
     std::string_view name() const override { return "sobol"; }
