@@ -15,9 +15,11 @@
 namespace drt {
 
 // Adaptive sampling: each pixel takes samples in rounds, each round as many as it has so far,
-// and stops once the standard error of its mean luminance (sample deviation / sqrt(n)) falls
-// below the threshold, or at the scene's sample count. The decision reads only the pixel's own
-// samples, so the image stays independent of the thread count.
+// and stops once the estimated standard error of its mean luminance falls below the threshold,
+// or at the scene's sample count. The estimate is the sample deviation over sqrt(n), or for a
+// progressive sampler the spread of the means of 8 consecutive runs over sqrt(8), which credits
+// stratification. The decision reads only the pixel's own samples, so the image stays
+// independent of the thread count.
 struct AdaptiveSampling {
     double noise_threshold = 0;  // in linear luminance units
     int min_samples = 16;        // taken before the estimate is trusted; capped at the maximum
