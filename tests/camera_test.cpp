@@ -5,20 +5,13 @@
 #include <cmath>
 #include <vector>
 
+#include "test_math.h"
+
 namespace drt {
 namespace {
 
-::testing::AssertionResult near(const Vec3& a, const Vec3& b, double tol) {
-    const double d = max_abs_component(a - b);
-    if (d <= tol) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure()
-           << "(" << a.x << ", " << a.y << ", " << a.z << ") vs (" << b.x << ", " << b.y << ", "
-           << b.z << ") differ by " << d << " > " << tol;
-}
-
-double angle_between(const Vec3& a, const Vec3& b) {
-    return std::atan2(length(cross(a, b)), dot(a, b));
-}
+using testing::near;
+using testing::angle_between;
 
 // Where `ray` crosses the plane at distance `distance` along `forward` from `eye`.
 Vec3 on_plane(const Ray& ray, const Vec3& eye, const Vec3& forward, double distance) {

@@ -8,22 +8,15 @@
 
 #include "drt/rng.h"
 #include "drt/sampler.h"
+#include "test_math.h"
 
 namespace drt {
 namespace {
 
+using testing::unit_vector;
+using testing::angle_between;
+
 constexpr Color kWhite{1, 1, 1};
-
-double angle_between(const Vec3& a, const Vec3& b) {
-    return std::atan2(length(cross(a, b)), dot(a, b));
-}
-
-Vec3 unit_vector(std::uint64_t seed, std::uint64_t i) {
-    const double z = 1.0 - 2.0 * to_unit(hash_of(seed, i, 0));
-    const double phi = 2.0 * kPi * to_unit(hash_of(seed, i, 1));
-    const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
-    return {s * std::cos(phi), s * std::sin(phi), z};
-}
 
 // k well-distributed points of the unit square.
 std::vector<Vec2> stratified_square(std::uint32_t k, std::uint32_t key) {

@@ -9,30 +9,19 @@
 #include <vector>
 
 #include "drt/rng.h"
+#include "test_math.h"
 
 namespace drt {
 namespace {
+
+using testing::near;
+using testing::unit_vector;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
 const Material& plain_material() {
     static const Material material{};
     return material;
-}
-
-::testing::AssertionResult near(const Vec3& a, const Vec3& b, double tol) {
-    const double d = max_abs_component(a - b);
-    if (d <= tol) return ::testing::AssertionSuccess();
-    return ::testing::AssertionFailure()
-           << "(" << a.x << ", " << a.y << ", " << a.z << ") vs (" << b.x << ", " << b.y << ", "
-           << b.z << ") differ by " << d << " > " << tol;
-}
-
-Vec3 unit_vector(std::uint64_t seed, std::uint64_t i) {
-    const double z = 1.0 - 2.0 * to_unit(hash_of(seed, i, 0));
-    const double phi = 2.0 * kPi * to_unit(hash_of(seed, i, 1));
-    const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
-    return {s * std::cos(phi), s * std::sin(phi), z};
 }
 
 // Reports the texture coordinates it is evaluated at as its colour.

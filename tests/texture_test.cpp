@@ -8,21 +8,17 @@
 
 #include "drt/rng.h"
 #include "drt/sphere.h"
+#include "test_math.h"
 
 namespace drt {
 namespace {
+
+using testing::unit_vector;
 
 Vec3 random_point(std::uint64_t seed, std::uint64_t i, double extent) {
     return {extent * (2 * to_unit(hash_of(seed, i, 0)) - 1),
             extent * (2 * to_unit(hash_of(seed, i, 1)) - 1),
             extent * (2 * to_unit(hash_of(seed, i, 2)) - 1)};
-}
-
-Vec3 unit_vector(std::uint64_t seed, std::uint64_t i) {
-    const double z = 1.0 - 2.0 * to_unit(hash_of(seed, i, 0));
-    const double phi = 2.0 * kPi * to_unit(hash_of(seed, i, 1));
-    const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
-    return {s * std::cos(phi), s * std::sin(phi), z};
 }
 
 TEST(TexturePerlinNoise, VanishesOnTheIntegerLattice) {
