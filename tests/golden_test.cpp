@@ -17,6 +17,17 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A reference of 64 renders of a flat grey square of the given size and per-pixel variance.
+golden::Reference flat_reference(int size, float variance) {
+    golden::Reference r;
+    r.renders = 64;
+    r.mean = Image(size, size);
+    r.variance = Image(size, size);
+    std::fill(r.mean.rgb.begin(), r.mean.rgb.end(), 0.5f);
+    std::fill(r.variance.rgb.begin(), r.variance.rgb.end(), variance);
+    return r;
+}
+
 const fs::path kScenes = fs::path(DRT_SOURCE_DIR) / "scenes";
 const fs::path kGolden = fs::path(DRT_SOURCE_DIR) / "tests" / "golden";
 const fs::path kDiffs = DRT_GOLDEN_DIFF_DIR;
@@ -95,12 +106,7 @@ TEST(GoldenFiles, EveryReferenceHasAScene) {
 // The test itself: it must pass the reference's own mean and catch a small, uniform change,
 // and it must not be fooled by a NaN.
 TEST(GoldenCheck, AcceptsTheMeanAndRejectsAShiftOfAFewStandardErrors) {
-    golden::Reference r;
-    r.renders = 64;
-    r.mean = Image(32, 32);
-    r.variance = Image(32, 32);
-    std::fill(r.mean.rgb.begin(), r.mean.rgb.end(), 0.5f);
-    std::fill(r.variance.rgb.begin(), r.variance.rgb.end(), 0.01f);  // σ = 0.1 per pixel
+    const golden::Reference r = flat_reference(32, 0.01f);  // σ = 0.1 per pixel
     EXPECT_TRUE(golden::check(r.mean, r).pass);
 
     // The whole image 0.012 brighter in red: u = 0.012 / sqrt(0.01 · (1 + 1/64) + (1e-3 · 0.5 +
@@ -127,11 +133,7 @@ TEST(GoldenCheck, AcceptsTheMeanAndRejectsAShiftOfAFewStandardErrors) {
 }
 
 TEST(GoldenCheck, DeterministicPixelsMayOnlyMoveByRounding) {
-    golden::Reference r;
-    r.renders = 64;
-    r.mean = Image(8, 8);
-    r.variance = Image(8, 8);  // zero: every render agreed
-    std::fill(r.mean.rgb.begin(), r.mean.rgb.end(), 0.5f);
+    const golden::Reference r = flat_reference(8, 0);  // zero variance: every render agreed
     Image close = r.mean;
     for (float& v : close.rgb) v += 1e-5f;  // float rounding of 0.5 is 3e-8; this is 300 times more
     EXPECT_TRUE(golden::check(close, r).pass);
@@ -163,12 +165,7 @@ Image noisy(const Image& mean, double sigma, unsigned seed) {
 }
 
 TEST(GoldenCheck, ToleratesANoisierEstimatorButNotAShiftHiddenInIt) {
-    golden::Reference r;
-    r.renders = 64;
-    r.mean = Image(64, 64);
-    r.variance = Image(64, 64);
-    std::fill(r.mean.rgb.begin(), r.mean.rgb.end(), 0.5f);
-    std::fill(r.variance.rgb.begin(), r.variance.rgb.end(), 0.01f);  // σ = 0.1 per pixel
+    const golden::Reference r = flat_reference(64, 0.01f);  // σ = 0.1 per pixel
 
     const golden::Verdict same = golden::check(noisy(r.mean, 0.1, 1), r);
     EXPECT_TRUE(same.pass) << same.summary();
