@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <span>
+#include <vector>
 
 #include "drt/rng.h"
 
@@ -50,17 +51,23 @@ Integrator::Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bv
     }
 }
 
-Color Integrator::sample_pixel(int x, int y, const PixelSample& s, RayCounts& counts) const {
+void Integrator::sample_pixel(int x, int y, const PixelSample& s, std::span<Color> out,
+                              RayCounts& counts) const {
     const Effects& e = plan_.effects;
-    Vec2 film{x + 0.5, y + 0.5};
+    std::vector<Vec2> film(out.size(), Vec2{x + 0.5, y + 0.5});
     if (e.antialiasing) {
-        const Vec2 u = sampler_.get_2d(s, dim::kPixel);
-        film = {x + u.x, y + u.y};
+        sampler_.get_2d_run(s, dim::kPixel, film);
+        for (Vec2& f : film) f = {x + f.x, y + f.y};
     }
-    const Vec2 lens = e.depth_of_field ? sampler_.get_2d(s, dim::kLens) : Vec2{0.5, 0.5};
-    const double time = e.motion_blur ? sampler_.get_1d(s, dim::kTime) * plan_.shutter_end : 0.0;
-    ++counts.camera;
-    return radiance(camera_.generate_ray(film, lens, time), s, 0, counts);
+    std::vector<Vec2> lens(out.size(), Vec2{0.5, 0.5});
+    if (e.depth_of_field) sampler_.get_2d_run(s, dim::kLens, lens);
+    PixelSample sample = s;
+    for (std::size_t i = 0; i < out.size(); ++i, ++sample.index) {
+        const double time =
+            e.motion_blur ? sampler_.get_1d(sample, dim::kTime) * plan_.shutter_end : 0.0;
+        ++counts.camera;
+        out[i] = radiance(camera_.generate_ray(film[i], lens[i], time), sample, 0, counts);
+    }
 }
 
 Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth,

@@ -106,7 +106,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     // any other starts a new pattern of the round's size, on its own ray-tree path, in each round
     // (the first round is exactly a plain render at the minimum count).
     auto adaptive_pixel = [&](int x, int y, RayCounts& rays, PixelTally& tally,
-                              std::vector<double>& luminances) {
+                              std::vector<Color>& colors, std::vector<double>& luminances) {
         const auto min_spp = static_cast<std::uint32_t>(adaptive->min_samples);
         const auto pixel = static_cast<std::uint32_t>(y * settings.width + x);
         Color sum;
@@ -116,9 +116,10 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
             const std::uint32_t batch = std::min(round == 0 ? min_spp : n, spp - n);
             PixelSample s{settings.seed, pixel, 0, sampler->progressive() ? spp : batch};
             if (!sampler->progressive() && round > 0) s.path = hash_of(0xada9717eULL, round);
-            const std::uint32_t first = sampler->progressive() ? n : 0;
-            for (s.index = first; s.index < first + batch; ++s.index) {
-                const Color c = integrator.sample_pixel(x, y, s, rays);
+            s.index = sampler->progressive() ? n : 0;
+            colors.resize(batch);
+            integrator.sample_pixel(x, y, s, colors, rays);
+            for (const Color& c : colors) {
                 sum += c;
                 luminances.push_back(luminance(c));
             }
@@ -137,21 +138,21 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     auto worker = [&](int id) {
         RayCounts local;  // summed once at the end: shared counters would contend on every ray
         PixelTally tally;
+        std::vector<Color> colors(spp);  // of the pixel in hand, reused
         std::vector<double> luminances;  // of the adaptive pixel in hand, reused
         for (std::size_t t; (t = next_tile.fetch_add(1)) < tiles.size();) {
             const Tile& tile = tiles[t];
             for (int y = tile.y0; y < tile.y1; ++y) {
                 for (int x = tile.x0; x < tile.x1; ++x) {
                     if (adaptive) {
-                        adaptive_pixel(x, y, local, tally, luminances);
+                        adaptive_pixel(x, y, local, tally, colors, luminances);
                         continue;
                     }
                     PixelSample s{settings.seed,
                                   static_cast<std::uint32_t>(y * settings.width + x), 0, spp};
+                    integrator.sample_pixel(x, y, s, colors, local);
                     Color sum;
-                    for (s.index = 0; s.index < spp; ++s.index) {
-                        sum += integrator.sample_pixel(x, y, s, local);
-                    }
+                    for (const Color& c : colors) sum += c;
                     tally.samples += spp;
                     result.image.set(x, y, sum / spp);
                 }

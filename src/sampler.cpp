@@ -144,6 +144,14 @@ double camera_coordinate(const CameraSample& c, int d) {
 
 }  // namespace
 
+void Sampler::get_2d_run(const PixelSample& s, std::uint32_t dim, std::span<Vec2> out) const {
+    PixelSample sample = s;
+    for (Vec2& point : out) {
+        point = get_2d(sample, dim);
+        ++sample.index;
+    }
+}
+
 void Sampler::get_2d_set(const PixelSample& s, std::uint32_t dim, std::uint32_t k,
                          std::uint32_t first, std::span<Vec2> out) const {
     for (std::size_t i = 0; i < out.size(); ++i) {
@@ -182,21 +190,57 @@ void IndependentSampler::get_2d_set(const PixelSample& s, std::uint32_t dim, std
     }
 }
 
+namespace {
+
+// Kensler's pattern for any k: an m x n grid of cells, m*n >= k, as square as possible. Point
+// s (a shuffled j) takes its own stratum of y among k strata, and its own column sx and
+// sub-column sy of x among m*n; when k = m*n each cell of the grid holds exactly one point.
+// Which of the m*n sub-columns stay empty when k < m*n is left to the shuffles, so every point
+// is uniform over the square (a fixed choice would leave a corner unsampled).
+struct JitteredGrid {
+    std::uint32_t k, m, n, key;
+    JitteredGrid(std::uint32_t k_, std::uint32_t key_)
+        : k(k_), m(std::max(1u, static_cast<std::uint32_t>(std::sqrt(double(k_))))),  // floor
+          n((k_ + m - 1) / m), key(key_) {}
+
+    std::uint32_t stratum(std::uint32_t j) const { return permute(j, k, key * 0x51633e2du); }
+    std::uint32_t column(std::uint32_t c) const { return permute(c, m, key * 0x68bc21ebu); }
+    std::uint32_t sub_column(std::uint32_t r) const { return permute(r, n, key * 0x02e5be93u); }
+
+    Vec2 point(std::uint32_t s, std::uint32_t sx, std::uint32_t sy) const {
+        const std::uint64_t h = hash_of(key, s);  // hash_of(key, s, c) continues it
+        const double jx = to_unit(hash_combine(h, 1));
+        const double jy = to_unit(hash_combine(h, 2));
+        return {(sx + (sy + jx) / n) / m, (s + jy) / k};
+    }
+};
+
+}  // namespace
+
 Vec2 multi_jittered(std::uint32_t j, std::uint32_t k, std::uint32_t key) {
-    // Kensler's pattern for any k: an m x n grid of cells, m*n >= k, as square as possible. Point
-    // s (a shuffled j) takes its own stratum of y among k strata, and its own column sx and
-    // sub-column sy of x among m*n; when k = m*n each cell of the grid holds exactly one point.
-    // Which of the m*n sub-columns stay empty when k < m*n is left to the shuffles, so every
-    // point is uniform over the square (a fixed choice would leave a corner unsampled).
-    const auto m = std::max(1u, static_cast<std::uint32_t>(std::sqrt(double(k))));  // floor
-    const std::uint32_t n = (k + m - 1) / m;
-    const std::uint32_t s = permute(j, k, key * 0x51633e2du);
-    const std::uint32_t sx = permute(s % m, m, key * 0x68bc21ebu);
-    const std::uint32_t sy = permute(s / m, n, key * 0x02e5be93u);
-    const std::uint64_t h = hash_of(key, s);  // hash_of(key, s, c) continues it
-    const double jx = to_unit(hash_combine(h, 1));
-    const double jy = to_unit(hash_combine(h, 2));
-    return {(sx + (sy + jx) / n) / m, (s + jy) / k};
+    const JitteredGrid grid(k, key);
+    const std::uint32_t s = grid.stratum(j);
+    return grid.point(s, grid.column(s % grid.m), grid.sub_column(s / grid.m));
+}
+
+void multi_jittered_run(std::uint32_t first, std::uint32_t k, std::uint32_t key,
+                        std::span<Vec2> out) {
+    const JitteredGrid grid(k, key);
+    // Tabulating costs m + n shuffle evaluations, worth it once a run has more points than that.
+    constexpr std::uint32_t kTabulated = 64;
+    if (grid.n > kTabulated || out.size() < grid.m + grid.n) {
+        for (std::size_t i = 0; i < out.size(); ++i) {
+            out[i] = multi_jittered(first + static_cast<std::uint32_t>(i), k, key);
+        }
+        return;
+    }
+    std::array<std::uint32_t, kTabulated> columns, sub_columns;
+    for (std::uint32_t c = 0; c < grid.m; ++c) columns[c] = grid.column(c);
+    for (std::uint32_t r = 0; r < grid.n; ++r) sub_columns[r] = grid.sub_column(r);
+    for (std::size_t i = 0; i < out.size(); ++i) {
+        const std::uint32_t s = grid.stratum(first + static_cast<std::uint32_t>(i));
+        out[i] = grid.point(s, columns[s % grid.m], sub_columns[s / grid.m]);
+    }
 }
 
 namespace {
@@ -261,6 +305,11 @@ double StratifiedSampler::get_1d(const PixelSample& s, std::uint32_t dim) const 
 
 Vec2 StratifiedSampler::get_2d(const PixelSample& s, std::uint32_t dim) const {
     return multi_jittered(s.index, s.count, key32(hash_of(s.seed, s.pixel, dim, s.path)));
+}
+
+void StratifiedSampler::get_2d_run(const PixelSample& s, std::uint32_t dim,
+                                   std::span<Vec2> out) const {
+    multi_jittered_run(s.index, s.count, key32(hash_of(s.seed, s.pixel, dim, s.path)), out);
 }
 
 Vec2 StratifiedSampler::get_2d_in_set(const PixelSample& s, std::uint32_t dim, std::uint32_t j,

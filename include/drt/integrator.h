@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "drt/bvh.h"
@@ -39,8 +40,10 @@ class Integrator {
 public:
     Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bvh, const Sampler& sampler);
 
-    // One camera sample of pixel (x, y): the radiance along its camera ray.
-    Color sample_pixel(int x, int y, const PixelSample& s, RayCounts& counts) const;
+    // Camera samples s.index, s.index + 1, ... of pixel (x, y): the radiance along each camera
+    // ray, into out. A run of a pixel's samples shares the work of drawing their camera points.
+    void sample_pixel(int x, int y, const PixelSample& s, std::span<Color> out,
+                      RayCounts& counts) const;
 
     // Radiance arriving along `ray`, which is `depth` reflections/refractions from the camera.
     Color radiance(const Ray& ray, const PixelSample& s, int depth, RayCounts& counts) const;

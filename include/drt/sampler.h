@@ -60,6 +60,9 @@ public:
     // a pixel the points are distributed as well as the sampler can; dimensions are decorrelated.
     virtual double get_1d(const PixelSample& s, std::uint32_t dim) const = 0;
     virtual Vec2 get_2d(const PixelSample& s, std::uint32_t dim) const = 0;
+    // get_2d for camera samples s.index, s.index + 1, ... of the pixel, into out, at once: a
+    // sampler can work out what a pixel's samples share (the pattern's shuffles) only once.
+    virtual void get_2d_run(const PixelSample& s, std::uint32_t dim, std::span<Vec2> out) const;
 
     // Point j of a set of k taken within one camera sample (the shadow rays of one shading point,
     // the glossy rays of one hit): the k points are distributed well together.
@@ -97,6 +100,7 @@ public:
     std::string_view name() const override { return "stratified"; }
     double get_1d(const PixelSample& s, std::uint32_t dim) const override;
     Vec2 get_2d(const PixelSample& s, std::uint32_t dim) const override;
+    void get_2d_run(const PixelSample& s, std::uint32_t dim, std::span<Vec2> out) const override;
     Vec2 get_2d_in_set(const PixelSample& s, std::uint32_t dim, std::uint32_t j,
                        std::uint32_t k) const override;
     void get_2d_set(const PixelSample& s, std::uint32_t dim, std::uint32_t k, std::uint32_t first,
@@ -141,6 +145,10 @@ std::uint32_t sobol(std::uint32_t i, int dimension);
 
 // Point j of a correlated multi-jittered pattern of k points keyed by `key`.
 Vec2 multi_jittered(std::uint32_t j, std::uint32_t k, std::uint32_t key);
+// multi_jittered(first + i, k, key) into out[i], with the shuffles of the grid's columns and
+// sub-columns, which every point shares, worked out once.
+void multi_jittered_run(std::uint32_t first, std::uint32_t k, std::uint32_t key,
+                        std::span<Vec2> out);
 // Points first .. first + out.size() - 1 of a multi-jittered set of k points keyed by `key`:
 // the same pattern as multi_jittered, more cheaply, but labelled differently (a set is used
 // whole, so its points need not be shuffled one by one). What get_2d_in_set gives.
