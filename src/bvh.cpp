@@ -318,6 +318,7 @@ bool Bvh::occluded(const Ray& ray, Interval range) const {
 }
 
 bool Bvh::occluded(const Ray& ray, Interval range, const Occluders& occluders) const {
+    if (occluders.nothing) return false;
     if (occluders.everything) return traverse<true>(ray, range, occluders).has_value();
     // Only what was gathered: the planes whose bits are set and the listed primitives.
     const double origin_scale = max_abs_component(ray.origin);
@@ -409,8 +410,10 @@ Occluders Bvh::gather_occluders(const Vec3& origin, const Ball& target, double t
         if (!apart) found.planes |= std::uint64_t{1} << i;
     }
 
+    const bool only_listed = planes_.size() <= 64 && unbounded_.empty();
     if (nodes_.empty()) {
         found.everything = false;
+        found.nothing = only_listed && found.planes == 0;
         return found;
     }
     std::array<std::uint32_t, kStackSize> stack;
@@ -448,6 +451,7 @@ Occluders Bvh::gather_occluders(const Vec3& origin, const Ball& target, double t
         }
     }
     found.everything = false;
+    found.nothing = only_listed && found.planes == 0 && found.count == 0;
     return found;
 }
 

@@ -169,7 +169,8 @@ Color Integrator::light_ray(const Light& light, const LightSample& ls, const Vec
     // Light from behind the shading normal or below the surface itself adds nothing; no ray needed.
     if (cosine <= 0 || dot(geometric, ls.dir) <= 0) return {};
     ++counts.shadow;
-    if (bvh_.occluded({origin, ls.dir, time}, {0, ls.distance}, occluders)) return {};
+    if (!occluders.nothing && bvh_.occluded({origin, ls.dir, time}, {0, ls.distance}, occluders))
+        return {};
     return light.intensity() * cosine;
 }
 

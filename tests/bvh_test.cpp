@@ -197,6 +197,7 @@ TEST(Bvh, FromInsideTheLightEverythingIsKept) {
     const Bvh bvh(world.objects);
     const Occluders inside = bvh.gather_occluders({50, 50, 50}, {{50, 52, 50}, 5}, 0);
     EXPECT_TRUE(inside.everything);
+    EXPECT_FALSE(inside.nothing);
     EXPECT_EQ(inside.planes, ~std::uint64_t{0});
     // Far from every plane and sphere, towards a light in open space, nothing needs testing.
     Material material;
@@ -208,6 +209,11 @@ TEST(Bvh, FromInsideTheLightEverythingIsKept) {
     EXPECT_FALSE(none.everything);
     EXPECT_EQ(none.planes, 0u);
     EXPECT_EQ(none.count, 0);
+    EXPECT_TRUE(none.nothing);
+    // Towards a light beyond the plane, the plane may block.
+    const Occluders plane = room.gather_occluders({0, 10, 0}, {{0, -50, 0}, 5}, 0);
+    EXPECT_FALSE(plane.nothing);
+    EXPECT_EQ(plane.planes, 1u);
 }
 
 TEST(FastKernels, SinCosOfTurnsIsWithinTwoUlpsAndExactAtQuarters) {

@@ -32,6 +32,7 @@ struct Occluders {
     static constexpr int kMaxListed = 16;
     std::uint64_t planes = ~std::uint64_t{0};  // bit i: plane i may block (from the 65th, all may)
     bool everything = true;                    // whether to traverse the tree instead of the list
+    bool nothing = false;                      // nothing at all may block: no ray need be traced
     int count = 0;
     std::array<std::uint32_t, kMaxListed> primitives{};
 };
