@@ -245,13 +245,62 @@ void multi_jittered_run(std::uint32_t first, std::uint32_t k, std::uint32_t key,
 
 namespace {
 
-// A uniformly random order of 0 .. out.size()-1 (Fisher-Yates), each swap drawn from a hash of
-// `seed` by multiply-shift.
-void shuffle(std::span<std::uint32_t> out, std::uint64_t seed) {
+// Uniform random choices from few hashes: each choice of one of c takes the next digit of a
+// 32-bit random fraction f in radix c (the digit floor(f c), and f becomes frac(f c)), so one
+// hash serves several choices. A new hash is drawn before the digits taken so far would leave
+// under 12 bits of the fraction, which keeps every choice within 2^-12 of its share in relative
+// terms (and the sets the choices make are averaged over millions of shading points).
+class Digits {
+  public:
+    explicit Digits(std::uint64_t seed) : seed_(seed), fraction_(fresh()) {}
+
+    // Uniform in [0, c), for 1 <= c <= 2^12.
+    std::uint32_t below(std::uint32_t c) {
+        if (used_ * c > kMaxUsed) fraction_ = fresh(), used_ = 1;
+        used_ *= c;
+        const std::uint64_t product = std::uint64_t{fraction_} * c;
+        fraction_ = static_cast<std::uint32_t>(product);
+        return static_cast<std::uint32_t>(product >> 32);
+    }
+
+  private:
+    static constexpr std::uint64_t kMaxUsed = 1u << 20;  // of the fraction's 32 bits
+    std::uint32_t fresh() { return static_cast<std::uint32_t>(mix64(seed_ + ++draws_) >> 32); }
+
+    std::uint64_t seed_;
+    std::uint64_t draws_ = 0, used_ = 1;
+    std::uint32_t fraction_;
+};
+
+// A uniformly random order of 0 .. out.size()-1 (Fisher-Yates).
+void shuffle(std::span<std::uint32_t> out, Digits& digits) {
     for (std::uint32_t c = 0; c < out.size(); ++c) out[c] = c;
     for (auto c = static_cast<std::uint32_t>(out.size()); c > 1; --c) {
-        const std::uint64_t bits = mix64(seed + c) >> 32;
-        std::swap(out[c - 1], out[static_cast<std::uint32_t>((bits * c) >> 32)]);
+        std::swap(out[c - 1], out[digits.below(c)]);
+    }
+}
+
+// Exactly double(x) for x < 2^52, in integer operations that vectorise (x86 before AVX-512 has
+// no instruction converting 64-bit integers to doubles).
+double small_to_double(std::uint64_t x) {
+    return std::bit_cast<double>(x | 0x4330000000000000ULL) - 0x1.0p52;
+}
+
+// The points of a set with strata s[i] and cells c[i]: x = (c + jx) / (m n), y = (s + jy) / k,
+// with both jitters from one hash of s. The jitters' 32 bits keep both below 1 for any
+// k < 2^20, and the clamp beyond. The AVX2 clone does the same IEEE operations as the default,
+// four lanes at a time, so its points are bit-identical.
+__attribute__((target_clones("avx2", "default"))) void jittered_points(
+    std::uint64_t h, const std::uint64_t* s, const std::uint64_t* c, double inv_cells,
+    double inv_k, Vec2* out, std::size_t count) {
+    constexpr double kBelowOne = 0x1.fffffffffffffp-1;
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::uint64_t jitter = mix64(h + s[i]);
+        const double jx = small_to_double(jitter >> 32) * 0x1.0p-32;
+        const double jy = small_to_double(jitter & 0xffffffffu) * 0x1.0p-32;
+        const double x = (small_to_double(c[i]) + jx) * inv_cells;
+        const double y = (small_to_double(s[i]) + jy) * inv_k;
+        out[i] = {x < kBelowOne ? x : kBelowOne, y < kBelowOne ? y : kBelowOne};
     }
 }
 
@@ -263,37 +312,46 @@ void multi_jittered_set(std::uint32_t first, std::uint32_t k, std::uint32_t key,
     // points are labelled by a rotation of the strata rather than a shuffle (each point is still
     // uniform over the square, and the set as a whole is the same pattern), both jitters come
     // from one hash, and the shuffles of the grid's columns and sub-columns, which every point
-    // shares, are dealt once by Fisher-Yates (for a grid of up to 32 x 32 cells, k <= 1024).
+    // shares, are dealt once by Fisher-Yates (for a grid of up to 32 x 32 cells, k <= 1024),
+    // from as few hashes as they need (one for k up to 20).
     const auto m = std::max(1u, static_cast<std::uint32_t>(std::sqrt(double(k))));  // floor
     const std::uint32_t n = (k + m - 1) / m;
     constexpr std::uint32_t kTabulated = 32;
     std::array<std::uint32_t, kTabulated> column, sub_column;
     const bool tabulated = n <= kTabulated;  // m <= n
     const std::uint64_t h = mix64(key ^ 0x7f4a7c159e3779b9ULL);
+    Digits digits(h ^ 0x68bc21ebu);
     if (tabulated) {
-        shuffle(std::span(column).first(m), h ^ 0x68bc21ebu);
-        shuffle(std::span(sub_column).first(n), h ^ 0x02e5be93u);
+        shuffle(std::span(column).first(m), digits);
+        shuffle(std::span(sub_column).first(n), digits);
     }
-    const auto rotation = static_cast<std::uint32_t>(((h >> 32) * k) >> 32);  // uniform in [0, k)
-    // x = (sx + (sy + jx) / n) / m and y = (s + jy) / k, with the divisions as products; the
-    // jitters' 32 bits keep both below 1 for any k < 2^20, and the clamp beyond.
+    const std::uint32_t rotation = k <= 4096 ? digits.below(k)
+                                             : static_cast<std::uint32_t>(((h >> 32) * k) >> 32);
+    // x = (sx + (sy + jx) / n) / m and y = (s + jy) / k, with the divisions as products.
     const double inv_cells = 1.0 / (double(m) * n), inv_k = 1.0 / k;
-    constexpr double kBelowOne = 0x1.fffffffffffffp-1;
-    std::uint32_t s = (first % k + rotation) % k;
+    std::uint32_t s = (first < k ? first : first % k) + rotation;
+    if (s >= k) s -= k;
     std::uint32_t col = s % m, row = s / m;  // s = row * m + col, kept up to date as s steps
-    for (std::size_t i = 0; i < out.size(); ++i) {
-        const std::uint32_t sx = tabulated ? column[col] : permute(col, m, key * 0x68bc21ebu);
-        const std::uint32_t sy = tabulated ? sub_column[row] : permute(row, n, key * 0x02e5be93u);
-        const std::uint64_t jitter = mix64(h + s);
-        const double jx = static_cast<double>(jitter >> 32) * 0x1.0p-32;
-        const double jy = static_cast<double>(jitter & 0xffffffffu) * 0x1.0p-32;
-        out[i] = {std::min((sx * n + sy + jx) * inv_cells, kBelowOne),
-                  std::min((s + jy) * inv_k, kBelowOne)};
-        if (++s == k) {
-            s = col = row = 0;
-        } else if (++col == m) {
-            col = 0, ++row;
+    // A chunk at a time: the strata and cells in a scalar loop (it carries s from point to
+    // point), then the jitters and coordinates in one that vectorises.
+    constexpr std::size_t kChunk = 16;
+    std::array<std::uint64_t, kChunk> stratum, cell;  // s and sx * n + sy
+    for (std::size_t done = 0; done < out.size(); done += kChunk) {
+        const std::size_t count = std::min(kChunk, out.size() - done);
+        for (std::size_t i = 0; i < count; ++i) {
+            const std::uint32_t sx = tabulated ? column[col] : permute(col, m, key * 0x68bc21ebu);
+            const std::uint32_t sy =
+                tabulated ? sub_column[row] : permute(row, n, key * 0x02e5be93u);
+            stratum[i] = s;
+            cell[i] = sx * n + sy;
+            if (++s == k) {
+                s = col = row = 0;
+            } else if (++col == m) {
+                col = 0, ++row;
+            }
         }
+        jittered_points(h, stratum.data(), cell.data(), inv_cells, inv_k, out.data() + done,
+                        count);
     }
 }
 
