@@ -95,8 +95,8 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth,
 
     Color result;
     if (m.has_diffuse()) {
-        const Color light =
-            scene_.ambient + direct_light(surface.point, geometric, shading, ray.time, s, depth, counts);
+        const Color light = scene_.ambient + direct_light(surface.point, geometric, shading,
+                                                          ray.time, s, depth, counts);
         result += m.diffuse * surface.kd * light;
     }
     if (depth >= scene_.settings.max_depth) return result;  // deeper rays would contribute black
@@ -121,7 +121,8 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth,
         }
         if (fresnel < 1) {
             auto through = refract(ray.dir, shading, eta);
-            if (!through || dot(*through, geometric) >= 0) through = refract(ray.dir, geometric, eta);
+            if (!through || dot(*through, geometric) >= 0)
+                through = refract(ray.dir, geometric, eta);
             if (through) {
                 glass += (1.0 - fresnel) * scattered(surface.point, geometric, *through, sigma, -1,
                                                      ray.time, s, depth, dim::kGlossRefract, true,
@@ -134,9 +135,8 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth,
 }
 
 Color Integrator::scattered(const Vec3& point, const Vec3& geometric, const Vec3& ideal,
-                            double sigma, double side, double time, const PixelSample& s,
-                            int depth, std::uint32_t kind, bool refraction,
-                            RayCounts& counts) const {
+                            double sigma, double side, double time, const PixelSample& s, int depth,
+                            std::uint32_t kind, bool refraction, RayCounts& counts) const {
     const std::uint32_t dimension = dim::bounce(depth, kind);
     const int rays = sigma > 0 && depth == 0 ? scene_.settings.glossy_rays : 1;
     Color sum;
@@ -152,12 +152,14 @@ Color Integrator::scattered(const Vec3& point, const Vec3& geometric, const Vec3
                     dir = ideal;
                     break;
                 }
-                const std::uint64_t h = hash_of(s.seed, s.pixel, s.index, dimension, s.path, j, attempt);
+                const std::uint64_t h =
+                    hash_of(s.seed, s.pixel, s.index, dimension, s.path, j, attempt);
                 u = {to_unit(h), to_unit(mix64(h))};
             }
         }
         ++(refraction ? counts.refraction : counts.reflection);
-        sum += radiance(spawn_ray(point, geometric, dir, time), s.branch(kind, j), depth + 1, counts);
+        sum +=
+            radiance(spawn_ray(point, geometric, dir, time), s.branch(kind, j), depth + 1, counts);
     }
     return rays == 1 ? sum : sum / rays;
 }
@@ -165,12 +167,10 @@ Color Integrator::scattered(const Vec3& point, const Vec3& geometric, const Vec3
 Color Integrator::light_ray(const Light& light, const LightSample& ls, const Vec3& origin,
                             const Vec3& geometric, const Vec3& shading, double time,
                             const Occluders& occluders, RayCounts& counts) const {
-    const double cosine = dot(shading, ls.dir);
-    // Light from behind the shading normal or below the surface itself adds nothing; no ray needed.
-    if (cosine <= 0 || dot(geometric, ls.dir) <= 0) return {};
+    const double cosine = lit_cosine(ls.dir, shading, geometric);
+    if (cosine == 0) return {};  // no ray needed
     ++counts.shadow;
-    if (!occluders.nothing && bvh_.occluded({origin, ls.dir, time}, {0, ls.distance}, occluders))
-        return {};
+    if (bvh_.occluded({origin, ls.dir, time}, {0, ls.distance}, occluders)) return {};
     return light.intensity() * cosine;
 }
 
@@ -184,6 +184,7 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
     constexpr int kChunk = 16;
     std::array<Vec2, kChunk> points;
     std::array<LightSample, kChunk> samples;
+    std::array<double, kChunk> cosines;
     Color sum;
     for (std::size_t i = 0; i < scene_.lights.size(); ++i) {
         const int rays = plan_.shadow_rays[i];
@@ -203,8 +204,18 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
                 sampler_.get_2d_set(s, dimension, static_cast<std::uint32_t>(rays),
                                     static_cast<std::uint32_t>(first), std::span(points).first(n));
             }
-            light.sample(point, std::span<const Vec2>(points).first(n),
-                         std::span(samples).first(n));
+            const auto chunk = std::span<const Vec2>(points).first(n);
+            if (occluders.nothing) {
+                // Every ray reaches the light: only the cosines are needed.
+                light.lit_cosines(point, shading, geometric, chunk, std::span(cosines).first(n));
+                for (std::size_t j = 0; j < n; ++j) {
+                    if (cosines[j] == 0) continue;
+                    ++counts.shadow;
+                    light_sum += light.intensity() * cosines[j];
+                }
+                continue;
+            }
+            light.sample(point, chunk, std::span(samples).first(n));
             for (std::size_t j = 0; j < n; ++j) {
                 light_sum += light_ray(light, samples[j], origin, geometric, shading, time,
                                        occluders, counts);
@@ -225,7 +236,8 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
                 std::upper_bound(cdf.begin(), cdf.end(), u.x) - cdf.begin(), cdf.size() - 1);
             const double lo = k == 0 ? 0.0 : cdf[k - 1];
             const double p = cdf[k] - lo;
-            u.x = std::clamp((u.x - lo) / p, 0.0, std::nextafter(1.0, 0.0));  // reuse within the pick
+            u.x =
+                std::clamp((u.x - lo) / p, 0.0, std::nextafter(1.0, 0.0));  // reuse within the pick
             const Light& light = *area_lights_[k];
             sum += light_ray(light, light.sample(point, u), origin, geometric, shading, time,
                              Occluders{}, counts) /

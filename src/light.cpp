@@ -32,21 +32,33 @@ struct Cone {
     Frame frame;  // n towards the centre
 
     Cone(const Vec3& x, const Vec3& centre, double radius, double d2_)
-        : d(std::sqrt(d2_)), d2(d2_), r2(radius * radius),
+        : d(std::sqrt(d2_)),
+          d2(d2_),
+          r2(radius * radius),
           cos_max(std::sqrt(std::max(0.0, 1.0 - r2 / d2))),
           frame(Frame::around((centre - x) / d)) {}
 
     // sample_cone(u, cos_max) in the frame, and the distance to the sphere along it. No branch
     // and no table look-up, so that a loop of these vectorises (sample_cone_batch).
     LightSample sample(Vec2 u) const {
+        const Vec3 dir = direction(u);
+        return {dir, distance(u)};
+    }
+
+    // Distance to the near side of the sphere along the direction: b - sqrt(r² - (d² - b²))
+    // with b = d cos θ, the distance to the point nearest the centre. It depends on θ alone, so
+    // its square root need not wait for the azimuth. At the cone's rim the ray grazes the
+    // sphere and rounding may miss, where b itself is exact enough.
+    double distance(Vec2 u) const {
+        const double cos_t = 1.0 - u.x * (1.0 - cos_max);
+        const double sin2_t = positive_part(1.0 - cos_t * cos_t);
+        return d * cos_t - std::sqrt(positive_part(r2 - d2 * sin2_t));
+    }
+
+    Vec3 direction(Vec2 u) const {
         const double cos_t = 1.0 - u.x * (1.0 - cos_max);
         const double sin2_t = positive_part(1.0 - cos_t * cos_t);
         const double sin_t = std::sqrt(sin2_t);
-        // Distance to the near side of the sphere along the direction: b - sqrt(r² - (d² - b²))
-        // with b = d cos θ, the distance to the point nearest the centre. It depends on θ alone,
-        // so its square root need not wait for the azimuth. At the cone's rim the ray grazes
-        // the sphere and rounding may miss, where b itself is exact enough.
-        const double dist = d * cos_t - std::sqrt(positive_part(r2 - d2 * sin2_t));
         // The azimuth as q quarter turns plus a fraction: turning the tangents by a quarter
         // swaps the two coordinates and negates one, which is exact, so only the fraction
         // needs a polynomial.
@@ -66,9 +78,8 @@ struct Cone {
         const Vec3& t = frame.t;
         const Vec3& b = frame.b;
         const Vec3& n = frame.n;
-        return {{t.x * x + b.x * y + n.x * cos_t, t.y * x + b.y * y + n.y * cos_t,
-                 t.z * x + b.z * y + n.z * cos_t},
-                dist};
+        return {t.x * x + b.x * y + n.x * cos_t, t.y * x + b.y * y + n.y * cos_t,
+                t.z * x + b.z * y + n.z * cos_t};
     }
 };
 
@@ -76,15 +87,34 @@ struct Cone {
 // does the same IEEE operations (no fused multiply-adds), four lanes at a time, so its results
 // are bit-identical to the scalar sample's (tests/light_test.cpp checks) and images do not
 // depend on the machine.
-__attribute__((target_clones("avx2", "default"))) void sample_cone_batch(
-    const Cone& cone, const Vec2* u, LightSample* out, std::size_t count) {
+__attribute__((target_clones("avx2", "default"))) void sample_cone_batch(const Cone& cone,
+                                                                         const Vec2* u,
+                                                                         LightSample* out,
+                                                                         std::size_t count) {
     for (std::size_t i = 0; i < count; ++i) out[i] = cone.sample(u[i]);
+}
+
+// lit_cosine for every point, from Cone::direction: the same operations as sample() and the
+// dot products after it, so the same bits, without the distances.
+__attribute__((target_clones("avx2", "default"))) void lit_cosine_batch(const Cone& cone,
+                                                                        const Vec3& shading,
+                                                                        const Vec3& geometric,
+                                                                        const Vec2* u, double* out,
+                                                                        std::size_t count) {
+    for (std::size_t i = 0; i < count; ++i)
+        out[i] = lit_cosine(cone.direction(u[i]), shading, geometric);
 }
 
 }  // namespace
 
 void Light::sample(const Vec3& x, std::span<const Vec2> u, std::span<LightSample> out) const {
     for (std::size_t i = 0; i < u.size(); ++i) out[i] = sample(x, u[i]);
+}
+
+void Light::lit_cosines(const Vec3& x, const Vec3& shading, const Vec3& geometric,
+                        std::span<const Vec2> u, std::span<double> out) const {
+    for (std::size_t i = 0; i < u.size(); ++i)
+        out[i] = lit_cosine(sample(x, u[i]).dir, shading, geometric);
 }
 
 LightSample SphereLight::sample(const Vec3& x, Vec2 u) const {
@@ -112,6 +142,18 @@ void SphereLight::sample(const Vec3& x, std::span<const Vec2> u, std::span<Light
 
 std::optional<double> SphereLight::intersect(const Ray& ray, Interval range) const {
     return intersect_sphere(centre_, radius_, ray, range);
+}
+
+void SphereLight::lit_cosines(const Vec3& x, const Vec3& shading, const Vec3& geometric,
+                              std::span<const Vec2> u, std::span<double> out) const {
+    const Vec3 to_centre = centre_ - x;
+    const double d2 = dot(to_centre, to_centre);
+    if (d2 <= radius_ * radius_) {
+        Light::lit_cosines(x, shading, geometric, u, out);
+        return;
+    }
+    lit_cosine_batch(Cone(x, centre_, radius_, d2), shading, geometric, u.data(), out.data(),
+                     u.size());
 }
 
 }  // namespace drt

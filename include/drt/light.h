@@ -30,6 +30,10 @@ class Light {
     // sample(x, u[i]) for every i, into out[i]: a light can work out what the samples of one
     // shading point share (for a sphere, the cone it subtends) only once. Same results.
     virtual void sample(const Vec3& x, std::span<const Vec2> u, std::span<LightSample> out) const;
+    // For each u[i], lit_cosine of sample(x, u[i]).dir into out[i]: what each shadow ray of a
+    // shading point would bring if nothing blocked the light, without the distances. Same bits.
+    virtual void lit_cosines(const Vec3& x, const Vec3& shading, const Vec3& geometric,
+                             std::span<const Vec2> u, std::span<double> out) const;
     // A ball holding every point sample() aims at from outside it, so that what can block the
     // shadow rays of a shading point can be found once for all of them (Bvh::gather_occluders).
     virtual Ball extent() const = 0;
@@ -69,6 +73,8 @@ class SphereLight final : public Light {
     // sphere, where that cone is ill-defined, uniform over all directions.
     LightSample sample(const Vec3& x, Vec2 u) const override;
     void sample(const Vec3& x, std::span<const Vec2> u, std::span<LightSample> out) const override;
+    void lit_cosines(const Vec3& x, const Vec3& shading, const Vec3& geometric,
+                     std::span<const Vec2> u, std::span<double> out) const override;
     Ball extent() const override { return {centre_, radius_}; }
     bool is_point() const override { return false; }
     std::optional<double> intersect(const Ray& ray, Interval range) const override;
@@ -80,6 +86,14 @@ class SphereLight final : public Light {
     Vec3 centre_;
     double radius_;
 };
+
+// The cosine between a direction towards a light and the shading normal, when the direction
+// leaves above both the shading normal's horizon and the surface itself, and 0 otherwise: light
+// from behind either adds nothing, and no shadow ray is cast for it.
+inline double lit_cosine(const Vec3& dir, const Vec3& shading, const Vec3& geometric) {
+    const double cosine = dot(shading, dir);
+    return (cosine > 0) & (dot(geometric, dir) > 0) ? cosine : 0.0;
+}
 
 // Uniformly distributed direction in the cone of half-angle acos(cos_max) about +z. Inline: one
 // per shadow ray.
