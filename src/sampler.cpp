@@ -4,6 +4,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <vector>
 
 #include "drt/rng.h"
 
@@ -11,7 +12,9 @@ namespace drt {
 
 namespace {
 
-std::uint32_t key32(std::uint64_t h) { return static_cast<std::uint32_t>(h ^ (h >> 32)); }
+std::uint32_t key32(std::uint64_t h) {
+    return static_cast<std::uint32_t>(h ^ (h >> 32));
+}
 
 constexpr std::uint32_t reverse_bits(std::uint32_t x) {
     x = (x >> 16) | (x << 16);
@@ -95,7 +98,9 @@ constexpr ByteTables kSobolBytes = [] {
     return t;
 }();
 
-constexpr double unit32(std::uint32_t x) { return x * 0x1.0p-32; }
+constexpr double unit32(std::uint32_t x) {
+    return x * 0x1.0p-32;
+}
 
 // The keys of one dimension's sequence: an index shuffle and a scramble per coordinate.
 struct SobolKeys {
@@ -125,7 +130,9 @@ Vec2 sobol_point(std::uint32_t index, const SobolKeys& k) {
 // dimensions 2*dim and 2*dim + 1 of one sequence, so that they are stratified jointly: a pixel's
 // samples then spread over pixel area and lens together, not over each alone. Each Sobol
 // dimension has its own scramble.
-bool is_camera_dim(std::uint32_t dim) { return dim <= dim::kTime; }
+bool is_camera_dim(std::uint32_t dim) {
+    return dim <= dim::kTime;
+}
 
 struct CameraSample {
     std::uint32_t i;  // the shuffled index
@@ -200,8 +207,10 @@ namespace {
 struct JitteredGrid {
     std::uint32_t k, m, n, key;
     JitteredGrid(std::uint32_t k_, std::uint32_t key_)
-        : k(k_), m(std::max(1u, static_cast<std::uint32_t>(std::sqrt(double(k_))))),  // floor
-          n((k_ + m - 1) / m), key(key_) {}
+        : k(k_),
+          m(std::max(1u, static_cast<std::uint32_t>(std::sqrt(double(k_))))),  // floor
+          n((k_ + m - 1) / m),
+          key(key_) {}
 
     std::uint32_t stratum(std::uint32_t j) const { return permute(j, k, key * 0x51633e2du); }
     std::uint32_t column(std::uint32_t c) const { return permute(c, m, key * 0x68bc21ebu); }
@@ -286,20 +295,35 @@ double small_to_double(std::uint64_t x) {
     return std::bit_cast<double>(x | 0x4330000000000000ULL) - 0x1.0p52;
 }
 
-// The points of a set with strata s[i] and cells c[i]: x = (c + jx) / (m n), y = (s + jy) / k,
-// with both jitters from one hash of s. The jitters' 32 bits keep both below 1 for any
-// k < 2^20, and the clamp beyond. The AVX2 clone does the same IEEE operations as the default,
-// four lanes at a time, so its points are bit-identical.
+// A 32-bit bijective hash with full avalanche (Wellons' "lowbias32" constants); 32-bit
+// multiplies, unlike 64-bit ones, vectorise on x86 before AVX-512.
+constexpr std::uint32_t hash32(std::uint32_t x) {
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    return x ^ (x >> 16);
+}
+
+// Points first .. first + count - 1 of a set of k strata in which stratum s has the cell
+// cell_of[s] of the m x n grid, stratum (first + rotation) % k first: x = (cell + jx) / (m n),
+// y = (s + jy) / k, the jitters keyed by `key`. The jitters' 32 bits keep both below 1 for any
+// k < 2^20, and the clamp beyond. The AVX2 clone does the same operations as the default, eight
+// or four lanes at a time, so its points are bit-identical.
 __attribute__((target_clones("avx2", "default"))) void jittered_points(
-    std::uint64_t h, const std::uint64_t* s, const std::uint64_t* c, double inv_cells,
-    double inv_k, Vec2* out, std::size_t count) {
+    std::uint64_t key, std::uint32_t start, std::uint32_t k, const std::uint32_t* cell_of,
+    double inv_cells, double inv_k, Vec2* out, std::size_t count) {
     constexpr double kBelowOne = 0x1.fffffffffffffp-1;
+    const auto key_x = static_cast<std::uint32_t>(key),
+               key_y = static_cast<std::uint32_t>(key >> 32);
     for (std::size_t i = 0; i < count; ++i) {
-        const std::uint64_t jitter = mix64(h + s[i]);
-        const double jx = small_to_double(jitter >> 32) * 0x1.0p-32;
-        const double jy = small_to_double(jitter & 0xffffffffu) * 0x1.0p-32;
-        const double x = (small_to_double(c[i]) + jx) * inv_cells;
-        const double y = (small_to_double(s[i]) + jy) * inv_k;
+        std::uint32_t s = start + static_cast<std::uint32_t>(i);
+        s = s < k ? s : s - k;  // start < k and count <= k
+        const std::uint32_t jx = hash32(s + key_x);
+        const std::uint32_t jy = hash32(jx ^ key_y);
+        const double x =
+            (small_to_double(cell_of[s]) + small_to_double(jx) * 0x1.0p-32) * inv_cells;
+        const double y = (small_to_double(s) + small_to_double(jy) * 0x1.0p-32) * inv_k;
         out[i] = {x < kBelowOne ? x : kBelowOne, y < kBelowOne ? y : kBelowOne};
     }
 }
@@ -310,48 +334,47 @@ void multi_jittered_set(std::uint32_t first, std::uint32_t k, std::uint32_t key,
                         std::span<Vec2> out) {
     // Kensler's pattern as above, with economies for sets, which are always used whole: the
     // points are labelled by a rotation of the strata rather than a shuffle (each point is still
-    // uniform over the square, and the set as a whole is the same pattern), both jitters come
-    // from one hash, and the shuffles of the grid's columns and sub-columns, which every point
-    // shares, are dealt once by Fisher-Yates (for a grid of up to 32 x 32 cells, k <= 1024),
-    // from as few hashes as they need (one for k up to 20).
+    // uniform over the square, and the set as a whole is the same pattern), and the shuffles of
+    // the grid's columns and sub-columns, which every point shares, are dealt once by
+    // Fisher-Yates from as few hashes as they need (one for k up to 20) and tabulated per
+    // stratum.
     const auto m = std::max(1u, static_cast<std::uint32_t>(std::sqrt(double(k))));  // floor
     const std::uint32_t n = (k + m - 1) / m;
-    constexpr std::uint32_t kTabulated = 32;
-    std::array<std::uint32_t, kTabulated> column, sub_column;
-    const bool tabulated = n <= kTabulated;  // m <= n
     const std::uint64_t h = mix64(key ^ 0x7f4a7c159e3779b9ULL);
     Digits digits(h ^ 0x68bc21ebu);
-    if (tabulated) {
+    // The cell sx * n + sy of each stratum s = row * m + col: sx a shuffled col, sy a shuffled row.
+    constexpr std::uint32_t kSmall = 1024, kSides = 64;  // k <= 1024 has n <= 64
+    std::array<std::uint32_t, kSmall> small_table;
+    std::vector<std::uint32_t> large_table;
+    if (k > kSmall) large_table.resize(k);
+    const std::span<std::uint32_t> cell_of =
+        k > kSmall ? std::span(large_table) : std::span(small_table).first(k);
+    if (k <= kSmall) {
+        std::array<std::uint32_t, kSides> column, sub_column;
         shuffle(std::span(column).first(m), digits);
         shuffle(std::span(sub_column).first(n), digits);
-    }
-    const std::uint32_t rotation = k <= 4096 ? digits.below(k)
-                                             : static_cast<std::uint32_t>(((h >> 32) * k) >> 32);
-    // x = (sx + (sy + jx) / n) / m and y = (s + jy) / k, with the divisions as products.
-    const double inv_cells = 1.0 / (double(m) * n), inv_k = 1.0 / k;
-    std::uint32_t s = (first < k ? first : first % k) + rotation;
-    if (s >= k) s -= k;
-    std::uint32_t col = s % m, row = s / m;  // s = row * m + col, kept up to date as s steps
-    // A chunk at a time: the strata and cells in a scalar loop (it carries s from point to
-    // point), then the jitters and coordinates in one that vectorises.
-    constexpr std::size_t kChunk = 16;
-    std::array<std::uint64_t, kChunk> stratum, cell;  // s and sx * n + sy
-    for (std::size_t done = 0; done < out.size(); done += kChunk) {
-        const std::size_t count = std::min(kChunk, out.size() - done);
-        for (std::size_t i = 0; i < count; ++i) {
-            const std::uint32_t sx = tabulated ? column[col] : permute(col, m, key * 0x68bc21ebu);
-            const std::uint32_t sy =
-                tabulated ? sub_column[row] : permute(row, n, key * 0x02e5be93u);
-            stratum[i] = s;
-            cell[i] = sx * n + sy;
-            if (++s == k) {
-                s = col = row = 0;
-            } else if (++col == m) {
-                col = 0, ++row;
+        for (std::uint32_t row = 0, s = 0; row < n; ++row) {
+            for (std::uint32_t col = 0; col < m && s < k; ++col, ++s) {
+                cell_of[s] = column[col] * n + sub_column[row];
             }
         }
-        jittered_points(h, stratum.data(), cell.data(), inv_cells, inv_k, out.data() + done,
-                        count);
+    } else {
+        for (std::uint32_t s = 0; s < k; ++s) {
+            cell_of[s] =
+                permute(s % m, m, key * 0x68bc21ebu) * n + permute(s / m, n, key * 0x02e5be93u);
+        }
+    }
+    const std::uint32_t rotation =
+        k <= 4096 ? digits.below(k) : static_cast<std::uint32_t>(((h >> 32) * k) >> 32);
+    // x = (sx + (sy + jx) / n) / m and y = (s + jy) / k, with the divisions as products.
+    const double inv_cells = 1.0 / (double(m) * n), inv_k = 1.0 / k;
+    // A pass of at most k points at a time, so that the strata wrap around at most once.
+    for (std::size_t done = 0; done < out.size(); done += k) {
+        const std::uint32_t at = first + static_cast<std::uint32_t>(done);
+        std::uint32_t start = (at < k ? at : at % k) + rotation;
+        if (start >= k) start -= k;
+        jittered_points(mix64(h), start, k, cell_of.data(), inv_cells, inv_k, out.data() + done,
+                        std::min<std::size_t>(k, out.size() - done));
     }
 }
 
@@ -465,6 +488,8 @@ std::unique_ptr<Sampler> make_sampler(std::string_view name) {
     return nullptr;
 }
 
-std::vector<std::string> sampler_names() { return {"random", "stratified", "sobol"}; }
+std::vector<std::string> sampler_names() {
+    return {"random", "stratified", "sobol"};
+}
 
 }  // namespace drt
