@@ -261,7 +261,8 @@ namespace {
 // terms (and the sets the choices make are averaged over millions of shading points).
 class Digits {
   public:
-    explicit Digits(std::uint64_t seed) : seed_(seed), fraction_(fresh()) {}
+    // The first digits come from `first`, later ones from hashes of `seed`.
+    Digits(std::uint32_t first, std::uint64_t seed) : seed_(seed), fraction_(first) {}
 
     // Uniform in [0, c), for 1 <= c <= 2^12.
     std::uint32_t below(std::uint32_t c) {
@@ -341,7 +342,7 @@ void multi_jittered_set(std::uint32_t first, std::uint32_t k, std::uint32_t key,
     const auto m = std::max(1u, static_cast<std::uint32_t>(std::sqrt(double(k))));  // floor
     const std::uint32_t n = (k + m - 1) / m;
     const std::uint64_t h = mix64(key ^ 0x7f4a7c159e3779b9ULL);
-    Digits digits(h ^ 0x68bc21ebu);
+    Digits digits(static_cast<std::uint32_t>(h >> 32), h ^ 0x68bc21ebu);
     // The cell sx * n + sy of each stratum s = row * m + col: sx a shuffled col, sy a shuffled row.
     constexpr std::uint32_t kSmall = 1024, kSides = 64;  // k <= 1024 has n <= 64
     std::array<std::uint32_t, kSmall> small_table;
@@ -393,16 +394,28 @@ void StratifiedSampler::get_2d_run(const PixelSample& s, std::uint32_t dim,
     multi_jittered_run(s.index, s.count, key32(hash_of(s.seed, s.pixel, dim, s.path)), out);
 }
 
+namespace {
+
+// The key of one camera sample's set in one dimension of one ray-tree branch: (seed, pixel,
+// sample, dimension, branch) folded into three hashes rather than five, since sets are drawn
+// at every shading point.
+std::uint32_t set_key(const PixelSample& s, std::uint32_t dim) {
+    const std::uint64_t sample = (std::uint64_t{s.pixel} << 32) | s.index;
+    return key32(hash_of(s.seed, sample, s.path ^ (std::uint64_t{dim} * 0x9e3779b97f4a7c15ULL)));
+}
+
+}  // namespace
+
 Vec2 StratifiedSampler::get_2d_in_set(const PixelSample& s, std::uint32_t dim, std::uint32_t j,
                                       std::uint32_t k) const {
     Vec2 point;
-    multi_jittered_set(j, k, key32(hash_of(s.seed, s.pixel, s.index, dim, s.path)), {&point, 1});
+    multi_jittered_set(j, k, set_key(s, dim), {&point, 1});
     return point;
 }
 
 void StratifiedSampler::get_2d_set(const PixelSample& s, std::uint32_t dim, std::uint32_t k,
                                    std::uint32_t first, std::span<Vec2> out) const {
-    multi_jittered_set(first, k, key32(hash_of(s.seed, s.pixel, s.index, dim, s.path)), out);
+    multi_jittered_set(first, k, set_key(s, dim), out);
 }
 
 std::uint32_t nested_scramble(std::uint32_t x, std::uint32_t key) {
