@@ -63,6 +63,36 @@ TEST(LightSphere, BatchSamplesAreBitIdenticalToSingleOnes) {
     }
 }
 
+// The shortcut for shadow rays nothing blocks: the same cosines as sampling the direction and
+// taking lit_cosine of it, to rounding, and zero for the same directions away from the horizon.
+TEST(LightSphere, LitCosinesAreThoseOfTheSampledDirections) {
+    const SphereLight light({0, 10, 0}, 3, kWhite, false);
+    const std::vector<Vec2> u = stratified_square(256, 3);
+    std::vector<double> cosines(u.size());
+    int lit = 0, dark = 0;
+    for (int k = 0; k < 50; ++k) {
+        // Normals from straight at the light to past the horizon, and a geometric normal tilted
+        // away from the shading one, as on a bump-mapped surface.
+        const double tilt = 0.05 * k;
+        const Vec3 shading{std::sin(tilt), std::cos(tilt), 0};
+        const Vec3 geometric = normalize(Vec3{0, std::cos(0.8 * tilt), std::sin(0.8 * tilt)});
+        light.lit_cosines({0, 0, 0}, shading, geometric, u, cosines);
+        for (std::size_t i = 0; i < u.size(); ++i) {
+            const Vec3 dir = light.sample({0, 0, 0}, u[i]).dir;
+            const double expected = lit_cosine(dir, shading, geometric);
+            const bool near_horizon =
+                std::abs(dot(shading, dir)) < 1e-12 || std::abs(dot(geometric, dir)) < 1e-12;
+            if (!near_horizon) {
+                ASSERT_EQ(cosines[i] > 0, expected > 0) << k << " " << i;
+            }
+            EXPECT_NEAR(cosines[i], expected, 1e-15) << k << " " << i;
+            (expected > 0 ? lit : dark) += 1;
+        }
+    }
+    EXPECT_GT(lit, 1000);  // both cases occur
+    EXPECT_GT(dark, 1000);
+}
+
 TEST(LightSphere, PowerIsTheLuminanceOfTheIntensity) {
     const SphereLight light({0, 0, 0}, 1, {1, 0, 0}, false);
     EXPECT_DOUBLE_EQ(light.power(), 0.2126);

@@ -30,8 +30,9 @@ class Light {
     // sample(x, u[i]) for every i, into out[i]: a light can work out what the samples of one
     // shading point share (for a sphere, the cone it subtends) only once. Same results.
     virtual void sample(const Vec3& x, std::span<const Vec2> u, std::span<LightSample> out) const;
-    // For each u[i], lit_cosine of sample(x, u[i]).dir into out[i]: what each shadow ray of a
-    // shading point would bring if nothing blocked the light, without the distances. Same bits.
+    // For each u[i], lit_cosine of sample(x, u[i]).dir into out[i] (to rounding): what each
+    // shadow ray of a shading point would bring if nothing blocked the light, without the
+    // distances.
     virtual void lit_cosines(const Vec3& x, const Vec3& shading, const Vec3& geometric,
                              std::span<const Vec2> u, std::span<double> out) const;
     // A ball holding every point sample() aims at from outside it, so that what can block the
