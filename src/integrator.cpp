@@ -208,11 +208,12 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
             if (occluders.nothing) {
                 // Every ray reaches the light: only the cosines are needed.
                 light.lit_cosines(point, shading, geometric, chunk, std::span(cosines).first(n));
+                double cosine_sum = 0;
                 for (std::size_t j = 0; j < n; ++j) {
-                    if (cosines[j] == 0) continue;
-                    ++counts.shadow;
-                    light_sum += light.intensity() * cosines[j];
+                    cosine_sum += cosines[j];
+                    counts.shadow += cosines[j] > 0;  // a ray is cast only for a lit direction
                 }
+                light_sum += light.intensity() * cosine_sum;
                 continue;
             }
             light.sample(point, chunk, std::span(samples).first(n));

@@ -282,8 +282,35 @@ class Digits {
     std::uint32_t fraction_;
 };
 
-// A uniformly random order of 0 .. out.size()-1 (Fisher-Yates).
+// Every order of 0 .. n-1 for n up to kListedOrders, as n hexadecimal digits (digit c is the
+// c-th element), in lexicographic order.
+constexpr std::uint32_t kListedOrders = 5;
+using OrderList = std::array<std::uint32_t, 1 + 1 + 2 + 6 + 24 + 120>;  // sum of n! for n <= 5
+constexpr std::array<std::uint32_t, kListedOrders + 2> kOrderListStart = {0, 1, 2, 4, 10, 34, 154};
+constexpr OrderList kOrders = [] {
+    OrderList list{};
+    for (std::uint32_t n = 0; n <= kListedOrders; ++n) {
+        std::array<std::uint32_t, kListedOrders> order{};
+        for (std::uint32_t c = 0; c < n; ++c) order[c] = c;
+        for (std::uint32_t i = kOrderListStart[n]; i < kOrderListStart[n + 1]; ++i) {
+            for (std::uint32_t c = 0; c < n; ++c) list[i] |= order[c] << (4 * c);
+            std::next_permutation(order.begin(), order.begin() + n);
+        }
+    }
+    return list;
+}();
+
+// A uniformly random order of 0 .. out.size()-1: one of the listed orders when they are few,
+// else dealt by Fisher-Yates.
 void shuffle(std::span<std::uint32_t> out, Digits& digits) {
+    const auto size = static_cast<std::uint32_t>(out.size());
+    if (size <= kListedOrders) {
+        const std::uint32_t start = kOrderListStart[size];
+        const std::uint32_t order =
+            kOrders[start + digits.below(kOrderListStart[size + 1] - start)];
+        for (std::uint32_t c = 0; c < size; ++c) out[c] = (order >> (4 * c)) & 15u;
+        return;
+    }
     for (std::uint32_t c = 0; c < out.size(); ++c) out[c] = c;
     for (auto c = static_cast<std::uint32_t>(out.size()); c > 1; --c) {
         std::swap(out[c - 1], out[digits.below(c)]);
