@@ -405,9 +405,10 @@ Occluders Bvh::gather_occluders(const Vec3& origin, const Ball& target, double t
         const double margin = slack + kSlack * p.point_scale;
         const double from = dot(origin, p.normal) - p.offset;
         const double to = dot(target.centre, p.normal) - p.offset;
-        const bool apart = (from > near && to - target.radius > margin) ||
-                           (from < -near && to + target.radius < -margin);
-        if (!apart) found.planes |= std::uint64_t{1} << i;
+        // Without branches: which planes separate varies from point to point, unpredictably.
+        const bool apart = ((from > near) & (to - target.radius > margin)) |
+                           ((from < -near) & (to + target.radius < -margin));
+        found.planes |= std::uint64_t{!apart} << i;
     }
 
     const bool only_listed = planes_.size() <= 64 && unbounded_.empty();
