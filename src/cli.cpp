@@ -81,15 +81,17 @@ struct Overrides {
 std::string format_duration(double seconds) {
     const auto total = static_cast<long long>(std::llround(std::max(0.0, seconds)));
     std::ostringstream s;
-    if (total >= 3600) s << total / 3600 << ":" << std::setw(2) << std::setfill('0') << (total / 60) % 60;
-    else s << total / 60;
+    if (total >= 3600)
+        s << total / 3600 << ":" << std::setw(2) << std::setfill('0') << (total / 60) % 60;
+    else
+        s << total / 60;
     s << ":" << std::setw(2) << std::setfill('0') << total % 60;
     return s.str();
 }
 
 // A one-line progress display on a terminal: percent, elapsed and estimated remaining time.
 class ProgressDisplay {
-public:
+  public:
     ProgressDisplay(std::ostream& err, std::string label) : err_(err), label_(std::move(label)) {}
     void operator()(double done) {
         const double elapsed =
@@ -97,29 +99,35 @@ public:
         const double left = done > 0 ? elapsed * (1 - done) / done : 0;
         err_ << "\r" << label_ << " " << std::setw(3) << static_cast<int>(done * 100) << "%  "
              << format_duration(elapsed) << " elapsed";
-        if (done > 0 && done < 1) err_ << ", " << format_duration(left) << " left ";
-        else err_ << "         ";
+        if (done > 0 && done < 1)
+            err_ << ", " << format_duration(left) << " left ";
+        else
+            err_ << "         ";
         if (done >= 1) err_ << "\n";
         err_ << std::flush;
     }
 
-private:
+  private:
     std::ostream& err_;
     std::string label_;
     std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
-std::string json_bool(bool b) { return b ? "true" : "false"; }
+std::string json_bool(bool b) {
+    return b ? "true" : "false";
+}
 
 std::string json_string(const std::string& s) {
     std::string out = "\"";
     for (char c : s) {
-        if (c == '"' || c == '\\') out += '\\', out += c;
+        if (c == '"' || c == '\\')
+            out += '\\', out += c;
         else if (static_cast<unsigned char>(c) < 0x20) {
             char buf[8];
             std::snprintf(buf, sizeof buf, "\\u%04x", c);
             out += buf;
-        } else out += c;
+        } else
+            out += c;
     }
     return out + "\"";
 }
@@ -136,7 +144,8 @@ std::string stats_json(const Scene& scene, const RenderResult& r) {
       << ", \"samples_per_pixel\": " << s.samples << ",\n"
       << "  \"shadow_rays\": " << s.shadow_rays << ", \"glossy_rays\": " << s.glossy_rays
       << ", \"max_depth\": " << s.max_depth << ", \"seed\": " << s.seed
-      << ", \"sampler\": " << json_string(s.sampler) << ", \"threads\": " << r.stats.threads << ",\n"
+      << ", \"sampler\": " << json_string(s.sampler) << ", \"threads\": " << r.stats.threads
+      << ",\n"
       << "  \"rays\": {\"camera\": " << rays.camera << ", \"shadow\": " << rays.shadow
       << ", \"reflection\": " << rays.reflection << ", \"refraction\": " << rays.refraction
       << ", \"total\": " << rays.total() << "},\n"
@@ -159,8 +168,8 @@ std::string stats_json(const Scene& scene, const RenderResult& r) {
 
 // Writes text through a temporary file and a rename, like the images.
 void write_text_atomically(const fs::path& path, const std::string& text) {
-    const fs::path tmp = path.parent_path() /
-                         ("." + path.filename().string() + ".tmp-" + std::to_string(getpid()));
+    const fs::path tmp =
+        path.parent_path() / ("." + path.filename().string() + ".tmp-" + std::to_string(getpid()));
     {
         std::ofstream f(tmp, std::ios::binary);
         f << text << "\n";
@@ -247,9 +256,9 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output, c
             return outcome;
         }
         if (!job.quiet) {
-            err << "drt: wrote " << output.string() << " (" << outcome.width << "x" << outcome.height
-                << ", " << outcome.samples << " spp, " << std::fixed << std::setprecision(2)
-                << outcome.seconds << " s)\n"
+            err << "drt: wrote " << output.string() << " (" << outcome.width << "x"
+                << outcome.height << ", " << outcome.samples << " spp, " << std::fixed
+                << std::setprecision(2) << outcome.seconds << " s)\n"
                 << std::defaultfloat;
         }
     } catch (const SceneError& e) {
@@ -273,10 +282,14 @@ void print_summary(const std::vector<SceneOutcome>& outcomes, std::ostream& out)
         std::ostringstream size;
         if (o.width > 0) size << o.width << "x" << o.height;
         out << std::left << std::setw(32) << fs::path(o.scene).filename().string() << std::right
-            << std::setw(11) << size.str() << std::setw(9) << (o.samples ? std::to_string(o.samples) : "")
-            << std::fixed << std::setprecision(2) << std::setw(10) << o.seconds << std::setw(10)
-            << o.mrays_per_second << std::defaultfloat << "  "
-            << (o.status == kOk ? "ok" : o.status == kFailed ? "failed" : "bad input") << "\n";
+            << std::setw(11) << size.str() << std::setw(9)
+            << (o.samples ? std::to_string(o.samples) : "") << std::fixed << std::setprecision(2)
+            << std::setw(10) << o.seconds << std::setw(10) << o.mrays_per_second
+            << std::defaultfloat << "  "
+            << (o.status == kOk       ? "ok"
+                : o.status == kFailed ? "failed"
+                                      : "bad input")
+            << "\n";
     }
 }
 
@@ -285,10 +298,11 @@ bool is_folder_target(const std::string& output) {
 }
 
 int render_command(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
-    CLI::App app{"drt: distributed ray tracer (Cook, Porter & Carpenter 1984).\n"
-                 "Also: drt compare A B [--max-rmse X] [--diff D.png] | drt info SCENE.xml | "
-                 "drt converge SCENE.xml --spp 1,4,16",
-                 "drt"};
+    CLI::App app{
+        "drt: distributed ray tracer (Cook, Porter & Carpenter 1984).\n"
+        "Also: drt compare A B [--max-rmse X] [--diff D.png] | drt info SCENE.xml | "
+        "drt converge SCENE.xml --spp 1,4,16",
+        "drt"};
     std::vector<std::string> scenes;
     std::string output, stats;
     RenderJob job;
@@ -457,9 +471,10 @@ int info_command(int argc, const char* const* argv, std::ostream& out, std::ostr
 }
 
 int converge_command(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
-    CLI::App app{"Render a scene at several sample counts and show how its error against a "
-                 "reference falls with samples and with time",
-                 "drt converge"};
+    CLI::App app{
+        "Render a scene at several sample counts and show how its error against a "
+        "reference falls with samples and with time",
+        "drt converge"};
     std::string scene_path, counts_text = "1,4,16,64,256", reference_path, save_reference, csv;
     std::optional<int> reference_spp;
     Overrides overrides;
@@ -543,14 +558,15 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
         }
         out << std::setw(8) << "spp" << std::setw(11) << "seconds" << std::setw(13) << "rmse"
             << std::setw(13) << "relmse" << std::setw(10) << "mean_spp" << std::setw(13)
-            << "cpu_seconds" << "\n";
+            << "cpu_seconds"
+            << "\n";
         const Convergence c =
             measure_convergence(scene, counts, reference, options, [&](const ConvergencePoint& p) {
-                out << std::setw(8) << p.spp << std::fixed << std::setprecision(3)
-                    << std::setw(11) << p.seconds << std::defaultfloat << std::setprecision(5)
-                    << std::setw(13) << p.rmse << std::setw(13) << p.relmse
-                    << std::setprecision(4) << std::setw(10) << p.mean_spp << std::fixed
-                    << std::setprecision(3) << std::setw(13) << p.cpu_seconds << std::defaultfloat
+                out << std::setw(8) << p.spp << std::fixed << std::setprecision(3) << std::setw(11)
+                    << p.seconds << std::defaultfloat << std::setprecision(5) << std::setw(13)
+                    << p.rmse << std::setw(13) << p.relmse << std::setprecision(4) << std::setw(10)
+                    << p.mean_spp << std::fixed << std::setprecision(3) << std::setw(13)
+                    << p.cpu_seconds << std::defaultfloat
                     << (p.fitted ? "" : "  (pixel centres: not in the slopes)") << "\n"
                     << std::flush;
             });

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <charconv>
-#include <ctime>
 #include <cmath>
+#include <ctime>
 #include <iomanip>
 #include <limits>
 #include <sstream>
@@ -23,13 +23,13 @@ void require_same_size(const Image& a, const Image& b) {
 
 // Restores a scene's settings however the render ends.
 class SettingsGuard {
-public:
+  public:
     explicit SettingsGuard(Scene& scene) : scene_(scene), saved_(scene.settings) {}
     ~SettingsGuard() { scene_.settings = saved_; }
     SettingsGuard(const SettingsGuard&) = delete;
     SettingsGuard& operator=(const SettingsGuard&) = delete;
 
-private:
+  private:
     Scene& scene_;
     RenderSettings saved_;
 };

@@ -2,4 +2,6 @@
 
 #include "drt/cli.h"
 
-int main(int argc, char** argv) { return drt::run_cli(argc, argv, std::cout, std::cerr); }
+int main(int argc, char** argv) {
+    return drt::run_cli(argc, argv, std::cout, std::cerr);
+}

@@ -62,7 +62,8 @@ std::vector<Tile> make_tiles(int width, int height) {
     std::vector<Tile> tiles;
     for (int y = 0; y < height; y += kTileSize) {
         for (int x = 0; x < width; x += kTileSize) {
-            tiles.push_back({x, y, std::min(x + kTileSize, width), std::min(y + kTileSize, height)});
+            tiles.push_back(
+                {x, y, std::min(x + kTileSize, width), std::min(y + kTileSize, height)});
         }
     }
     return tiles;
@@ -83,10 +84,11 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     result.image = Image(settings.width, settings.height);
 
     const std::vector<Tile> tiles = make_tiles(settings.width, settings.height);
-    const int threads = std::max(
-        1, std::min<int>(options.threads > 0 ? options.threads
-                                             : static_cast<int>(std::thread::hardware_concurrency()),
-                         static_cast<int>(tiles.size())));
+    const int threads =
+        std::max(1, std::min<int>(options.threads > 0
+                                      ? options.threads
+                                      : static_cast<int>(std::thread::hardware_concurrency()),
+                                  static_cast<int>(tiles.size())));
     std::atomic<std::size_t> next_tile{0};
     std::atomic<std::size_t> tiles_done{0};
     std::vector<RayCounts> counts(threads);
@@ -148,8 +150,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                         adaptive_pixel(x, y, local, tally, colors, luminances);
                         continue;
                     }
-                    PixelSample s{settings.seed,
-                                  static_cast<std::uint32_t>(y * settings.width + x), 0, spp};
+                    PixelSample s{settings.seed, static_cast<std::uint32_t>(y * settings.width + x),
+                                  0, spp};
                     integrator.sample_pixel(x, y, s, colors, local);
                     Color sum;
                     for (const Color& c : colors) sum += c;
@@ -169,7 +171,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     for (int id = 0; id < threads; ++id) pool.emplace_back(worker, id);
     {
         std::unique_lock lock(mutex);
-        while (!finished.wait_for(lock, std::chrono::milliseconds(250), [&] { return running == 0; })) {
+        while (!finished.wait_for(lock, std::chrono::milliseconds(250),
+                                  [&] { return running == 0; })) {
             if (options.on_progress) {
                 lock.unlock();
                 options.on_progress(double(tiles_done.load()) / tiles.size());

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 
-
 namespace drt {
 
 Camera Scene::camera() const {

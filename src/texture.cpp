@@ -12,7 +12,8 @@ namespace {
 
 constexpr std::array<std::uint8_t, 256> make_permutation() {
     std::array<std::uint8_t, 256> p{};
-    for (std::uint32_t i = 0; i < 256; ++i) p[i] = static_cast<std::uint8_t>(permute(i, 256, 0x5eed1u));
+    for (std::uint32_t i = 0; i < 256; ++i)
+        p[i] = static_cast<std::uint8_t>(permute(i, 256, 0x5eed1u));
     return p;
 }
 constexpr std::array<std::uint8_t, 256> kPermutation = make_permutation();
@@ -24,23 +25,39 @@ constexpr int hash3(int x, int y, int z) {
 // Dot product of the lattice gradient picked by h (one of the 12 cube-edge directions) with d.
 constexpr double gradient_dot(int h, double x, double y, double z) {
     switch (h % 12) {
-        case 0: return x + y;
-        case 1: return -x + y;
-        case 2: return x - y;
-        case 3: return -x - y;
-        case 4: return x + z;
-        case 5: return -x + z;
-        case 6: return x - z;
-        case 7: return -x - z;
-        case 8: return y + z;
-        case 9: return -y + z;
-        case 10: return y - z;
-        default: return -y - z;
+        case 0:
+            return x + y;
+        case 1:
+            return -x + y;
+        case 2:
+            return x - y;
+        case 3:
+            return -x - y;
+        case 4:
+            return x + z;
+        case 5:
+            return -x + z;
+        case 6:
+            return x - z;
+        case 7:
+            return -x - z;
+        case 8:
+            return y + z;
+        case 9:
+            return -y + z;
+        case 10:
+            return y - z;
+        default:
+            return -y - z;
     }
 }
 
-constexpr double fade(double t) { return t * t * t * (t * (t * 6 - 15) + 10); }
-constexpr double mix(double a, double b, double t) { return a + t * (b - a); }
+constexpr double fade(double t) {
+    return t * t * t * (t * (t * 6 - 15) + 10);
+}
+constexpr double mix(double a, double b, double t) {
+    return a + t * (b - a);
+}
 
 }  // namespace
 

@@ -10,8 +10,8 @@
 namespace drt {
 namespace {
 
-using testing::near;
 using testing::angle_between;
+using testing::near;
 
 // Where `ray` crosses the plane at distance `distance` along `forward` from `eye`.
 Vec3 on_plane(const Ray& ray, const Vec3& eye, const Vec3& forward, double distance) {

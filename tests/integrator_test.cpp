@@ -75,7 +75,8 @@ TEST(Integrator, GlossyMirrorOfUniformBackgroundConservesEnergy) {
     for (int y = 0; y < r.image.height; ++y) {
         for (int x = 0; x < r.image.width; ++x) {
             const double v = r.image.at(x, y).r;
-            // Every perturbed ray escapes a convex mirror, so each pixel is exactly one of two values.
+            // Every perturbed ray escapes a convex mirror, so each pixel is exactly one of two
+            // values.
             ASSERT_TRUE(std::abs(v - 0.3) < 1e-6 || std::abs(v - 0.18) < 1e-6) << v;
         }
     }
@@ -151,9 +152,11 @@ TEST(Integrator, ImageIsIdenticalForOneAndTwoThreads) {
     Scene scene = floor_scene(40, 30);
     scene.settings.samples = 4;
     scene.settings.shadow_rays = 3;
-    scene.lights.push_back(std::make_unique<SphereLight>(Vec3{5, 20, 5}, 6.0, Color{1, 1, 1}, false));
+    scene.lights.push_back(
+        std::make_unique<SphereLight>(Vec3{5, 20, 5}, 6.0, Color{1, 1, 1}, false));
     const Material& m = testing::add_material(scene, testing::mirror({0.9, 0.9, 0.9}, 20.0));
-    scene.objects.push_back(std::make_unique<Sphere>(std::vector<Vec3>{{0, 5, 0}, {3, 5, 0}}, 5.0, m));
+    scene.objects.push_back(
+        std::make_unique<Sphere>(std::vector<Vec3>{{0, 5, 0}, {3, 5, 0}}, 5.0, m));
     const RenderResult one = render_with(scene, 1);
     const RenderResult two = render_with(scene, 2);
     EXPECT_EQ(one.image.rgb, two.image.rgb);
@@ -177,7 +180,8 @@ TEST(PerturbDirection, AngularSpreadMatchesSigma) {
     const int n = 64 * 64;
     for (int i = 0; i < n; ++i) {
         const Vec2 u = multi_jittered(i, n, 99);
-        const double angle = std::acos(std::min(1.0, dot(perturb_direction(ideal, sigma, u), ideal)));
+        const double angle =
+            std::acos(std::min(1.0, dot(perturb_direction(ideal, sigma, u), ideal)));
         sum_sq += angle * angle;
     }
     // The angle of a 2-D normal offset with per-axis deviation sigma has E[angle^2] = 2 sigma^2.

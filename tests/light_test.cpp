@@ -13,8 +13,8 @@
 namespace drt {
 namespace {
 
-using testing::unit_vector;
 using testing::angle_between;
+using testing::unit_vector;
 
 constexpr Color kWhite{1, 1, 1};
 
@@ -48,8 +48,8 @@ TEST(LightSphere, BatchSamplesAreBitIdenticalToSingleOnes) {
         // quarter turns, their boundaries and both ends of the square.
         for (const std::uint32_t k : {1u, 7u, 9u, 64u}) {
             std::vector<Vec2> u = stratified_square(k, k);
-            u.insert(u.end(), {{0, 0}, {1, 1}, {0.5, 0.125}, {0.25, 0.375}, {0.75, 0.625},
-                               {0.999, 0.875}});
+            u.insert(u.end(),
+                     {{0, 0}, {1, 1}, {0.5, 0.125}, {0.25, 0.375}, {0.75, 0.625}, {0.999, 0.875}});
             std::vector<LightSample> batch(u.size());
             light.sample(x, u, batch);
             for (std::size_t i = 0; i < u.size(); ++i) {

@@ -333,7 +333,6 @@ TEST(SamplerStratified, DimensionsAreDecorrelated) {
     EXPECT_NEAR(sum / count, 0.5, 1.0 / count);
 }
 
-
 // --- Owen-scrambled Sobol ---
 
 // True when the 2^m points form a (t,m,2)-net: every 2^a x 2^b grid with a + b = m - t has
@@ -417,11 +416,11 @@ TEST(SamplerSobol, FirstPointsAreTheSobolSequence) {
     // The first direction numbers the recurrence makes rather than the table gives, m_4
     // (m_5 for degree 4): 2 a_1 m_3 ^ 4 m_2 ^ m_2 (degree 2), 2 a_1 m_3 ^ 4 a_2 m_2 ^ 8 m_1 ^ m_1
     // (degree 3), 2 a_1 m_4 ^ 4 a_2 m_3 ^ 8 a_3 m_2 ^ 16 m_1 ^ m_1 (degree 4).
-    EXPECT_EQ(sobol(8, 1) * 0x1.0p-32, 15.0 / 16);  // 2*5 ^ 5
-    EXPECT_EQ(sobol(8, 2) * 0x1.0p-32, 9.0 / 16);   // 2*3 ^ 4*3 ^ 3
-    EXPECT_EQ(sobol(8, 3) * 0x1.0p-32, 5.0 / 16);   // 4*3 ^ 8 ^ 1
-    EXPECT_EQ(sobol(8, 4) * 0x1.0p-32, 11.0 / 16);  // 2*1 ^ 8 ^ 1
-    EXPECT_EQ(sobol(8, 5) * 0x1.0p-32, 3.0 / 16);   // the fourth initial m
+    EXPECT_EQ(sobol(8, 1) * 0x1.0p-32, 15.0 / 16);   // 2*5 ^ 5
+    EXPECT_EQ(sobol(8, 2) * 0x1.0p-32, 9.0 / 16);    // 2*3 ^ 4*3 ^ 3
+    EXPECT_EQ(sobol(8, 3) * 0x1.0p-32, 5.0 / 16);    // 4*3 ^ 8 ^ 1
+    EXPECT_EQ(sobol(8, 4) * 0x1.0p-32, 11.0 / 16);   // 2*1 ^ 8 ^ 1
+    EXPECT_EQ(sobol(8, 5) * 0x1.0p-32, 3.0 / 16);    // the fourth initial m
     EXPECT_EQ(sobol(16, 5) * 0x1.0p-32, 25.0 / 32);  // 8 a_3 m_2 ^ 16 m_1 ^ m_1 = 8 ^ 16 ^ 1
 }
 

@@ -22,7 +22,7 @@ struct LookAt {
 };
 
 class Camera {
-public:
+  public:
     static Camera look_at(const LookAt& view, int width, int height, Lens lens);
     // The thesis's pixel-plane camera: pixel (i, j) at world (i + ½, height − j − ½, 0), the eye
     // at (width/2, height/2, −width), looking along +z with y up. `pixel_size` ≠ 1 scales that
@@ -36,8 +36,9 @@ public:
     const Vec3& eye() const { return eye_; }
     const Vec3& forward() const { return forward_; }
 
-private:
-    Camera(Vec3 eye, Vec3 forward, Vec3 up_hint, double half_height, int width, int height, Lens lens);
+  private:
+    Camera(Vec3 eye, Vec3 forward, Vec3 up_hint, double half_height, int width, int height,
+           Lens lens);
 
     Vec3 eye_, right_, up_, forward_;
     double half_height_;  // of the image plane at distance 1

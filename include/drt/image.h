@@ -23,7 +23,8 @@ struct Image {
     }
     void set(int x, int y, const Color& c) {
         const std::size_t i = 3 * (static_cast<std::size_t>(y) * width + x);
-        rgb[i] = static_cast<float>(c.r), rgb[i + 1] = static_cast<float>(c.g), rgb[i + 2] = static_cast<float>(c.b);
+        rgb[i] = static_cast<float>(c.r), rgb[i + 1] = static_cast<float>(c.g),
+        rgb[i + 2] = static_cast<float>(c.b);
     }
 };
 
@@ -31,7 +32,7 @@ enum class ImageFormat { kPng, kBmp, kPfm };
 
 // A file that cannot be read, written or understood; the message names the file.
 class ImageError : public std::runtime_error {
-public:
+  public:
     using std::runtime_error::runtime_error;
 };
 

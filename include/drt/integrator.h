@@ -21,7 +21,8 @@ struct RayCounts {
 
     std::uint64_t total() const { return camera + shadow + reflection + refraction; }
     RayCounts& operator+=(const RayCounts& o) {
-        camera += o.camera, shadow += o.shadow, reflection += o.reflection, refraction += o.refraction;
+        camera += o.camera, shadow += o.shadow, reflection += o.reflection,
+            refraction += o.refraction;
         return *this;
     }
 };
@@ -37,7 +38,7 @@ Ray spawn_ray(const Vec3& point, const Vec3& normal, const Vec3& dir, double tim
 Vec3 perturb_direction(const Vec3& ideal, double sigma, Vec2 u);
 
 class Integrator {
-public:
+  public:
     Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bvh, const Sampler& sampler);
 
     // Camera samples s.index, s.index + 1, ... of pixel (x, y): the radiance along each camera
@@ -48,7 +49,7 @@ public:
     // Radiance arriving along `ray`, which is `depth` reflections/refractions from the camera.
     Color radiance(const Ray& ray, const PixelSample& s, int depth, RayCounts& counts) const;
 
-private:
+  private:
     // Σ lights at a point: I · max(0, N·ω) · visibility, averaged over each light's shadow rays.
     Color direct_light(const Vec3& point, const Vec3& geometric, const Vec3& shading, double time,
                        const PixelSample& s, int depth, RayCounts& counts) const;
@@ -59,8 +60,8 @@ private:
     // Average radiance along `rays` directions about `ideal` (one exactly ideal ray if sigma is
     // 0), each redrawn until it leaves on the `side` of the surface (+1 = the normal's side).
     Color scattered(const Vec3& point, const Vec3& geometric, const Vec3& ideal, double sigma,
-                    double side, double time, const PixelSample& s, int depth,
-                    std::uint32_t kind, bool refraction, RayCounts& counts) const;
+                    double side, double time, const PixelSample& s, int depth, std::uint32_t kind,
+                    bool refraction, RayCounts& counts) const;
 
     const Scene& scene_;
     const RenderPlan& plan_;

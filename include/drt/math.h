@@ -36,24 +36,42 @@ struct Vec3 {
     friend constexpr bool operator==(const Vec3&, const Vec3&) = default;
 };
 
-constexpr Vec3 operator+(Vec3 a, const Vec3& b) { return a += b; }
-constexpr Vec3 operator-(Vec3 a, const Vec3& b) { return a -= b; }
-constexpr Vec3 operator*(Vec3 a, double s) { return a *= s; }
-constexpr Vec3 operator*(double s, Vec3 a) { return a *= s; }
-constexpr Vec3 operator/(const Vec3& a, double s) { return a * (1.0 / s); }
-constexpr double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+constexpr Vec3 operator+(Vec3 a, const Vec3& b) {
+    return a += b;
+}
+constexpr Vec3 operator-(Vec3 a, const Vec3& b) {
+    return a -= b;
+}
+constexpr Vec3 operator*(Vec3 a, double s) {
+    return a *= s;
+}
+constexpr Vec3 operator*(double s, Vec3 a) {
+    return a *= s;
+}
+constexpr Vec3 operator/(const Vec3& a, double s) {
+    return a * (1.0 / s);
+}
+constexpr double dot(const Vec3& a, const Vec3& b) {
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 constexpr Vec3 cross(const Vec3& a, const Vec3& b) {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-inline double length(const Vec3& v) { return std::sqrt(dot(v, v)); }
-inline Vec3 normalize(const Vec3& v) { return v / length(v); }
+inline double length(const Vec3& v) {
+    return std::sqrt(dot(v, v));
+}
+inline Vec3 normalize(const Vec3& v) {
+    return v / length(v);
+}
 constexpr Vec3 min(const Vec3& a, const Vec3& b) {
     return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)};
 }
 constexpr Vec3 max(const Vec3& a, const Vec3& b) {
     return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)};
 }
-constexpr Vec3 lerp(const Vec3& a, const Vec3& b, double t) { return a + (b - a) * t; }
+constexpr Vec3 lerp(const Vec3& a, const Vec3& b, double t) {
+    return a + (b - a) * t;
+}
 inline double max_abs_component(const Vec3& v) {
     return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
 }
@@ -67,10 +85,9 @@ struct SinCos {
 // pairs and then pairs of pairs, so that its terms need not wait on one another.
 constexpr SinCos sincos_eighth(double a) {
     const double x = a * a, x2 = x * x, x4 = x2 * x2;
-    const double sin_series =
-        (1 - x * (1.0 / 6)) + x2 * (1.0 / 120 - x * (1.0 / 5040)) +
-        x4 * ((1.0 / 362880 - x * (1.0 / 39916800)) +
-              x2 * (1.0 / 6227020800 - x * (1.0 / 1307674368000)));
+    const double sin_series = (1 - x * (1.0 / 6)) + x2 * (1.0 / 120 - x * (1.0 / 5040)) +
+                              x4 * ((1.0 / 362880 - x * (1.0 / 39916800)) +
+                                    x2 * (1.0 / 6227020800 - x * (1.0 / 1307674368000)));
     const double cos_series =
         (1 - x * 0.5) + x2 * (1.0 / 24 - x * (1.0 / 720)) +
         x4 * ((1.0 / 40320 - x * (1.0 / 3628800)) +
@@ -107,7 +124,9 @@ constexpr SinCos sincos_turns(double turns) {
 }
 
 // Mirror direction of d about the normal n (both unit length).
-constexpr Vec3 reflect(const Vec3& d, const Vec3& n) { return d - n * (2.0 * dot(d, n)); }
+constexpr Vec3 reflect(const Vec3& d, const Vec3& n) {
+    return d - n * (2.0 * dot(d, n));
+}
 
 // An orthonormal basis around a unit vector, continuous except at one pole (Duff et al. 2017).
 struct Frame {
@@ -116,7 +135,9 @@ struct Frame {
         const double sign = std::copysign(1.0, n.z);
         const double a = -1.0 / (sign + n.z);
         const double k = n.x * n.y * a;
-        return {{1.0 + sign * n.x * n.x * a, sign * k, -sign * n.x}, {k, sign + n.y * n.y * a, -n.y}, n};
+        return {{1.0 + sign * n.x * n.x * a, sign * k, -sign * n.x},
+                {k, sign + n.y * n.y * a, -n.y},
+                n};
     }
     constexpr Vec3 to_world(const Vec3& v) const { return t * v.x + b * v.y + n * v.z; }
 };

@@ -36,7 +36,7 @@ struct SurfaceDetail {
 };
 
 class Object {
-public:
+  public:
     Object(const Material& material, SurfaceDetail detail)
         : material_(&material), detail_(std::move(detail)) {}
     virtual ~Object() = default;
@@ -57,7 +57,7 @@ public:
     // Surface information at ray.at(t), where t came from intersect().
     SurfaceHit surface_at(const Ray& ray, double t) const;
 
-protected:
+  protected:
     // The exact point on the surface nearest to `p`, which removes most of the rounding error
     // a hit point picks up from ray.at(t).
     virtual Vec3 project_to_surface(const Vec3& p, double time) const = 0;
@@ -66,7 +66,7 @@ protected:
     virtual Vec3 texture_point(const Vec3& point, double time) const = 0;
     virtual Vec3 bump_point(const Vec3& point, double time) const = 0;
 
-private:
+  private:
     const Material* material_;
     SurfaceDetail detail_;
 };

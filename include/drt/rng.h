@@ -26,7 +26,9 @@ constexpr std::uint64_t hash_of(std::uint64_t first, Ts... rest) {
 }
 
 // A uniform double in [0, 1) from the top 53 bits of a hash.
-constexpr double to_unit(std::uint64_t h) { return static_cast<double>(h >> 11) * 0x1.0p-53; }
+constexpr double to_unit(std::uint64_t h) {
+    return static_cast<double>(h >> 11) * 0x1.0p-53;
+}
 
 // A pseudo-random permutation of [0, n) evaluated at i: Kensler's function from "Correlated
 // Multi-Jittered Sampling" (2013), which cycle-walks a keyed bijection on the smallest

@@ -52,7 +52,7 @@ constexpr std::uint32_t light(int depth, std::size_t light_index) {
 }  // namespace dim
 
 class Sampler {
-public:
+  public:
     virtual ~Sampler() = default;
     virtual std::string_view name() const = 0;
 
@@ -81,7 +81,7 @@ public:
 
 // Independent uniform random numbers: the Monte Carlo baseline.
 class IndependentSampler final : public Sampler {
-public:
+  public:
     std::string_view name() const override { return "random"; }
     double get_1d(const PixelSample& s, std::uint32_t dim) const override;
     Vec2 get_2d(const PixelSample& s, std::uint32_t dim) const override;
@@ -96,7 +96,7 @@ public:
 // x and the m x n cells of the square are fully stratified only when k = m*n (e.g. square k).
 // Each dimension's pattern is keyed separately, so dimensions are decorrelated.
 class StratifiedSampler final : public Sampler {
-public:
+  public:
     std::string_view name() const override { return "stratified"; }
     double get_1d(const PixelSample& s, std::uint32_t dim) const override;
     Vec2 get_2d(const PixelSample& s, std::uint32_t dim) const override;
@@ -121,7 +121,7 @@ public:
 // indices i*K .. i*K+K-1 to, so a set of K is itself a net and the sets of a pixel's samples
 // together refine one another.
 class SobolSampler final : public Sampler {
-public:
+  public:
     std::string_view name() const override { return "sobol"; }
     double get_1d(const PixelSample& s, std::uint32_t dim) const override;
     Vec2 get_2d(const PixelSample& s, std::uint32_t dim) const override;

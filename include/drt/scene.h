@@ -19,10 +19,10 @@ namespace drt {
 struct RenderSettings {
     int width = 640;
     int height = 480;
-    int samples = 16;      // camera rays per pixel
-    int shadow_rays = 1;   // per shading point, shared among the area lights
-    int max_depth = 8;     // longest chain of reflection/refraction bounces
-    int glossy_rays = 1;   // rays per glossy reflection/refraction at the first hit
+    int samples = 16;     // camera rays per pixel
+    int shadow_rays = 1;  // per shading point, shared among the area lights
+    int max_depth = 8;    // longest chain of reflection/refraction bounces
+    int glossy_rays = 1;  // rays per glossy reflection/refraction at the first hit
     std::uint64_t seed = 0;
     std::string sampler = "stratified";
     // World units per pixel of the thesis's pixel-plane camera: 1 as the scene format defines

@@ -13,13 +13,14 @@ namespace drt {
 
 // A scene that cannot be rendered. what() is the whole message: "FILE:LINE: Element: message".
 class SceneError : public std::runtime_error {
-public:
+  public:
     using std::runtime_error::runtime_error;
 };
 
 struct LoadedScene {
     Scene scene;
-    // "FILE:LINE: warning: ..." for every unknown element or attribute, naming the nearest known one.
+    // "FILE:LINE: warning: ..." for every unknown element or attribute, naming the nearest known
+    // one.
     std::vector<std::string> warnings;
 };
 

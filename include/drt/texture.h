@@ -17,7 +17,7 @@ double perlin_noise(const Vec3& p);
 double turbulence(const Vec3& p, int octaves = 6);
 
 class Texture {
-public:
+  public:
     virtual ~Texture() = default;
     // Colour at a point in the object's own texture coordinates (Object::texture_point).
     virtual Color value(const Vec3& local) const = 0;
@@ -25,22 +25,22 @@ public:
 
 // Cells of edge `scale` alternating between two colours.
 class CheckerTexture final : public Texture {
-public:
+  public:
     CheckerTexture(Color a, Color b, double scale) : a_(a), b_(b), scale_(scale) {}
     Color value(const Vec3& local) const override;
 
-private:
+  private:
     Color a_, b_;
     double scale_;
 };
 
 // Veins of a sine wave disturbed by turbulence, blending between two colours.
 class MarbleTexture final : public Texture {
-public:
+  public:
     MarbleTexture(Color a, Color b, double scale) : a_(a), b_(b), scale_(scale) {}
     Color value(const Vec3& local) const override;
 
-private:
+  private:
     Color a_, b_;
     double scale_;
 };
