@@ -38,56 +38,41 @@ struct Cone {
           cos_max(std::sqrt(std::max(0.0, 1.0 - r2 / d2))),
           frame(Frame::around((centre - x) / d)) {}
 
-    // sample_cone(u, cos_max) in the frame, and the distance to the sphere along it. No branch
-    // and no table look-up, so that a loop of these vectorises (sample_cone_batch).
-    LightSample sample(Vec2 u) const {
-        const Vec3 dir = direction(u);
-        return {dir, distance(u)};
+    // A direction in the cone is t x + b y + n cos θ in the cone's frame; sin²θ is kept for the
+    // distance.
+    struct Coordinates {
+        double x, y, cos_t, sin2_t;
+    };
+
+    // sample_cone(u, cos_max) in the frame, without a branch or a table look-up, so that a loop
+    // of these vectorises (sample_cone_batch, lit_cosine_batch).
+    Coordinates coordinates(Vec2 u) const {
+        const double cos_t = 1.0 - u.x * (1.0 - cos_max);
+        const double sin2_t = positive_part(1.0 - cos_t * cos_t);
+        const double sin_t = std::sqrt(sin2_t);
+        const SinCos phi = sincos_turns(u.y);
+        return {sin_t * phi.cos, sin_t * phi.sin, cos_t, sin2_t};
+    }
+
+    Vec3 direction(const Coordinates& c) const {
+        const Vec3& t = frame.t;
+        const Vec3& b = frame.b;
+        const Vec3& n = frame.n;
+        return {t.x * c.x + b.x * c.y + n.x * c.cos_t, t.y * c.x + b.y * c.y + n.y * c.cos_t,
+                t.z * c.x + b.z * c.y + n.z * c.cos_t};
     }
 
     // Distance to the near side of the sphere along the direction: b - sqrt(r² - (d² - b²))
     // with b = d cos θ, the distance to the point nearest the centre. It depends on θ alone, so
     // its square root need not wait for the azimuth. At the cone's rim the ray grazes the
     // sphere and rounding may miss, where b itself is exact enough.
-    double distance(Vec2 u) const {
-        const double cos_t = 1.0 - u.x * (1.0 - cos_max);
-        const double sin2_t = positive_part(1.0 - cos_t * cos_t);
-        return d * cos_t - std::sqrt(positive_part(r2 - d2 * sin2_t));
+    double distance(const Coordinates& c) const {
+        return d * c.cos_t - std::sqrt(positive_part(r2 - d2 * c.sin2_t));
     }
 
-    // A direction in the cone is t x + b y + n cos θ in the cone's frame.
-    struct Coordinates {
-        double x, y, cos_t;
-    };
-
-    Coordinates coordinates(Vec2 u) const {
-        const double cos_t = 1.0 - u.x * (1.0 - cos_max);
-        const double sin2_t = positive_part(1.0 - cos_t * cos_t);
-        const double sin_t = std::sqrt(sin2_t);
-        // The azimuth as q quarter turns plus a fraction: turning the tangents by a quarter
-        // swaps the two coordinates and negates one, which is exact, so only the fraction
-        // needs a polynomial.
-        const auto [q, a] = quarter_turns(u.y);
-        const SinCos phi = sincos_eighth(a);
-        const double along = sin_t * phi.cos, across = sin_t * phi.sin;
-        // Selected and negated on the bits: a branch on a random quadrant is mispredicted
-        // three times in four, and bit operations vectorise.
-        const auto bits = [](double v) { return std::bit_cast<std::uint64_t>(v); };
-        const std::uint64_t odd = 0 - static_cast<std::uint64_t>(q & 1);  // all ones for odd q
-        const auto sign = [](int bit) { return static_cast<std::uint64_t>(bit & 2) << 62; };
-        // x is negated in the second and third quarters, y in the third and fourth.
-        return {std::bit_cast<double>(((bits(along) & ~odd) | (bits(across) & odd)) ^ sign(q + 1)),
-                std::bit_cast<double>(((bits(across) & ~odd) | (bits(along) & odd)) ^ sign(q)),
-                cos_t};
-    }
-
-    Vec3 direction(Vec2 u) const {
-        const auto [x, y, cos_t] = coordinates(u);
-        const Vec3& t = frame.t;
-        const Vec3& b = frame.b;
-        const Vec3& n = frame.n;
-        return {t.x * x + b.x * y + n.x * cos_t, t.y * x + b.y * y + n.y * cos_t,
-                t.z * x + b.z * y + n.z * cos_t};
+    LightSample sample(Vec2 u) const {
+        const Coordinates c = coordinates(u);
+        return {direction(c), distance(c)};
     }
 };
 
@@ -114,9 +99,9 @@ __attribute__((target_clones("avx2", "default"))) void lit_cosine_batch(const Co
     const Vec3 s{dot(shading, f.t), dot(shading, f.b), dot(shading, f.n)};
     const Vec3 g{dot(geometric, f.t), dot(geometric, f.b), dot(geometric, f.n)};
     for (std::size_t i = 0; i < count; ++i) {
-        const auto [x, y, cos_t] = cone.coordinates(u[i]);
-        const double cosine = s.x * x + s.y * y + s.z * cos_t;
-        out[i] = (cosine > 0) & (g.x * x + g.y * y + g.z * cos_t > 0) ? cosine : 0.0;
+        const Cone::Coordinates c = cone.coordinates(u[i]);
+        const double cosine = s.x * c.x + s.y * c.y + s.z * c.cos_t;
+        out[i] = (cosine > 0) & (g.x * c.x + g.y * c.y + g.z * c.cos_t > 0) ? cosine : 0.0;
     }
 }
 
