@@ -333,9 +333,9 @@ constexpr std::uint32_t hash32(std::uint32_t x) {
     return x ^ (x >> 16);
 }
 
-// Points first .. first + count - 1 of a set of k strata in which stratum s has the cell
-// cell_of[s] of the m x n grid, stratum (first + rotation) % k first: x = (cell + jx) / (m n),
-// y = (s + jy) / k, the jitters keyed by `key`. The jitters' 32 bits keep both below 1 for any
+// `count` points of a set of k strata in which stratum s has the cell cell_of[s] of the m x n
+// grid, from stratum `start` on: x = (cell + jx) / (m n), y = (s + jy) / k, the jitters keyed by
+// `key`. The jitters' 32 bits keep both below 1 for any
 // k < 2^20, and the clamp beyond. The AVX2 clone does the same operations as the default, eight
 // or four lanes at a time, so its points are bit-identical.
 __attribute__((target_clones("avx2", "default"))) void jittered_points(
@@ -366,8 +366,8 @@ void multi_jittered_set(std::uint32_t first, std::uint32_t k, std::uint32_t key,
     // the grid's columns and sub-columns, which every point shares, are dealt once by
     // Fisher-Yates from as few hashes as they need (one for k up to 20) and tabulated per
     // stratum.
-    const auto m = std::max(1u, static_cast<std::uint32_t>(std::sqrt(double(k))));  // floor
-    const std::uint32_t n = (k + m - 1) / m;
+    const JitteredGrid grid(k, key);
+    const std::uint32_t m = grid.m, n = grid.n;
     const std::uint64_t h = mix64(key ^ 0x7f4a7c159e3779b9ULL);
     Digits digits(static_cast<std::uint32_t>(h >> 32), h ^ 0x68bc21ebu);
     // The cell sx * n + sy of each stratum s = row * m + col: sx a shuffled col, sy a shuffled row.
@@ -388,8 +388,7 @@ void multi_jittered_set(std::uint32_t first, std::uint32_t k, std::uint32_t key,
         }
     } else {
         for (std::uint32_t s = 0; s < k; ++s) {
-            cell_of[s] =
-                permute(s % m, m, key * 0x68bc21ebu) * n + permute(s / m, n, key * 0x02e5be93u);
+            cell_of[s] = grid.column(s % m) * n + grid.sub_column(s / m);
         }
     }
     const std::uint32_t rotation =

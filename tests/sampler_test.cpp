@@ -282,6 +282,17 @@ TEST(SamplerStratified, Get2dInSetIsAMultiJitteredPatternOverTheSet) {
     }
 }
 
+// Sets of more than 1024 points take the shuffles from Kensler's permutation rather than from
+// a tabulated deal, and beyond 4096 the rotation from the hash's high bits: the same pattern.
+TEST(SamplerStratified, LargeSetsAreMultiJitteredPatternsToo) {
+    const StratifiedSampler sampler;
+    for (const std::uint32_t k : {1025u, 1500u, 4100u}) {
+        std::vector<Vec2> points(k);
+        sampler.get_2d_set({8, 1234, 1, 3}, dim::bounce(0, dim::kLight), k, 0, points);
+        EXPECT_TRUE(multi_jittered_strata(points)) << "set of " << k;
+    }
+}
+
 TEST(SamplerStratified, MultiJitteredIsStratifiedForManyKeys) {
     for (const std::uint32_t k : kCounts) {
         for (std::uint32_t key = 0; key < 20; ++key) {
