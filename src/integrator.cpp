@@ -53,6 +53,7 @@ Integrator::Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bv
 
 void Integrator::sample_pixel(int x, int y, const PixelSample& s, std::span<Color> out,
                               RayCounts& counts) const {
+    PixelWork work{counts, RunPoints(sampler_, s, static_cast<std::uint32_t>(out.size()))};
     const Effects& e = plan_.effects;
     std::vector<Vec2> film(out.size(), Vec2{x + 0.5, y + 0.5});
     if (e.antialiasing) {
@@ -66,12 +67,17 @@ void Integrator::sample_pixel(int x, int y, const PixelSample& s, std::span<Colo
         const double time =
             e.motion_blur ? sampler_.get_1d(sample, dim::kTime) * plan_.shutter_end : 0.0;
         ++counts.camera;
-        out[i] = radiance(camera_.generate_ray(film[i], lens[i], time), sample, 0, counts);
+        out[i] = radiance(camera_.generate_ray(film[i], lens[i], time), sample, 0, work);
     }
 }
 
 Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth,
                            RayCounts& counts) const {
+    PixelWork work{counts, RunPoints(sampler_, s, 0)};
+    return radiance(ray, s, depth, work);
+}
+
+Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, PixelWork& work) const {
     const auto hit = bvh_.intersect(ray, {0, kInfinity});
     if (any_visible_light_) {
         double nearest = hit ? hit->t : kInfinity;
@@ -96,7 +102,7 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth,
     Color result;
     if (m.has_diffuse()) {
         const Color light = scene_.ambient + direct_light(surface.point, geometric, shading,
-                                                          ray.time, s, depth, counts);
+                                                          ray.time, s, depth, work.counts);
         result += m.diffuse * surface.kd * light;
     }
     if (depth >= scene_.settings.max_depth) return result;  // deeper rays would contribute black
@@ -106,7 +112,7 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth,
         const Vec3 ideal = reflect_above(ray.dir, shading, geometric);
         result += m.reflective * m.ks *
                   scattered(surface.point, geometric, ideal, sigma, +1, ray.time, s, depth,
-                            dim::kGlossReflect, false, counts);
+                            dim::kGlossReflect, false, work);
     }
     if (m.transmits()) {
         // The medium outside every object is air (index 1), as in the thesis.
@@ -117,16 +123,16 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth,
         if (fresnel > 0) {
             glass += fresnel * scattered(surface.point, geometric,
                                          reflect_above(ray.dir, shading, geometric), sigma, +1,
-                                         ray.time, s, depth, dim::kGlassReflect, false, counts);
+                                         ray.time, s, depth, dim::kGlassReflect, false, work);
         }
         if (fresnel < 1) {
             auto through = refract(ray.dir, shading, eta);
             if (!through || dot(*through, geometric) >= 0)
                 through = refract(ray.dir, geometric, eta);
             if (through) {
-                glass += (1.0 - fresnel) * scattered(surface.point, geometric, *through, sigma, -1,
-                                                     ray.time, s, depth, dim::kGlossRefract, true,
-                                                     counts);
+                glass +=
+                    (1.0 - fresnel) * scattered(surface.point, geometric, *through, sigma, -1,
+                                                ray.time, s, depth, dim::kGlossRefract, true, work);
             }
         }
         result += m.transmit * m.kt * glass;
@@ -136,14 +142,14 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth,
 
 Color Integrator::scattered(const Vec3& point, const Vec3& geometric, const Vec3& ideal,
                             double sigma, double side, double time, const PixelSample& s, int depth,
-                            std::uint32_t kind, bool refraction, RayCounts& counts) const {
+                            std::uint32_t kind, bool refraction, PixelWork& work) const {
     const std::uint32_t dimension = dim::bounce(depth, kind);
     const int rays = sigma > 0 && depth == 0 ? scene_.settings.glossy_rays : 1;
     Color sum;
     for (int j = 0; j < rays; ++j) {
         Vec3 dir = ideal;
         if (sigma > 0) {
-            Vec2 u = rays == 1 ? sampler_.get_2d(s, dimension)
+            Vec2 u = rays == 1 ? work.points.get_2d(s, dimension)
                                : sampler_.get_2d_in_set(s, dimension, j, rays);
             for (int attempt = 1;; ++attempt) {
                 dir = perturb_direction(ideal, sigma, u);
@@ -157,9 +163,8 @@ Color Integrator::scattered(const Vec3& point, const Vec3& geometric, const Vec3
                 u = {to_unit(h), to_unit(mix64(h))};
             }
         }
-        ++(refraction ? counts.refraction : counts.reflection);
-        sum +=
-            radiance(spawn_ray(point, geometric, dir, time), s.branch(kind, j), depth + 1, counts);
+        ++(refraction ? work.counts.refraction : work.counts.reflection);
+        sum += radiance(spawn_ray(point, geometric, dir, time), s.branch(kind, j), depth + 1, work);
     }
     return rays == 1 ? sum : sum / rays;
 }

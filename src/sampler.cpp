@@ -166,6 +166,27 @@ void Sampler::get_2d_set(const PixelSample& s, std::uint32_t dim, std::uint32_t 
     }
 }
 
+Vec2 RunPoints::get_2d(const PixelSample& s, std::uint32_t dim) {
+    const std::uint32_t at = s.index - first_.index;
+    const bool in_run = s.seed == first_.seed && s.pixel == first_.pixel &&
+                        s.count == first_.count && s.index >= first_.index && at < length_;
+    if (!in_run) return sampler_.get_2d(s, dim);
+    auto found = std::find_if(remembered_.begin(), remembered_.end(), [&](const Remembered& r) {
+        return r.dim == dim && r.path == s.path;
+    });
+    if (found == remembered_.end()) {
+        if (remembered_.size() == kMaxRemembered) return sampler_.get_2d(s, dim);
+        found = remembered_.insert(remembered_.end(), Remembered{dim, s.path, 0, {}});
+    }
+    if (!found->points.empty()) return found->points[at];
+    if (++found->requests < kDrawAfter) return sampler_.get_2d(s, dim);
+    PixelSample run = first_;
+    run.path = s.path;
+    found->points.resize(length_);
+    sampler_.get_2d_run(run, dim, found->points);
+    return found->points[at];
+}
+
 PixelSample PixelSample::branch(std::uint64_t kind, std::uint64_t j) const {
     PixelSample child = *this;
     child.path = hash_of(path, kind, j);

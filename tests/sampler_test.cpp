@@ -124,6 +124,59 @@ TEST(Sampler, SetsAtOnceEqualPointsOneByOne) {
     }
 }
 
+TEST(Sampler, RunsAtOnceEqualPointsOneByOne) {
+    for (const std::string& name : sampler_names()) {
+        const auto sampler = make_sampler(name);
+        for (const std::uint32_t count : {1u, 7u, 82u, 100u}) {
+            const PixelSample first{9, 40, count / 4, count, 77};
+            std::vector<Vec2> points(count - count / 4);
+            sampler->get_2d_run(first, dim::kPixel, points);
+            PixelSample s = first;
+            for (const Vec2& point : points) {
+                const Vec2 p = sampler->get_2d(s, dim::kPixel);
+                EXPECT_EQ(point.x, p.x) << name << " count " << count << " index " << s.index;
+                EXPECT_EQ(point.y, p.y) << name << " count " << count << " index " << s.index;
+                ++s.index;
+            }
+        }
+    }
+}
+
+// RunPoints in the order a renderer asks: sample by sample, each asking for several dimensions
+// on several branches, some only now and then, more pairs than it remembers, and samples from
+// outside the run.
+TEST(Sampler, RunPointsAreExactlyGet2dsInAnyOrder) {
+    for (const std::string& name : sampler_names()) {
+        const auto sampler = make_sampler(name);
+        const PixelSample first{3, 123, 16, 48};
+        RunPoints run(*sampler, first, 24);
+        int asked = 0;
+        for (std::uint32_t index = 10; index < 48; ++index) {
+            for (std::uint32_t d = 0; d < 40; ++d) {
+                const std::uint32_t dimension = dim::bounce(static_cast<int>(d % 8), d / 8);
+                if ((index * 7 + d) % (d < 20 ? 1 : 5) != 0) continue;
+                PixelSample s = first;
+                s.index = index;
+                s.path = first.branch(d % 3, d).path;
+                const Vec2 expected = sampler->get_2d(s, dimension);
+                const Vec2 got = run.get_2d(s, dimension);
+                EXPECT_EQ(got.x, expected.x) << name << " index " << index << " d " << d;
+                EXPECT_EQ(got.y, expected.y) << name << " index " << index << " d " << d;
+                ++asked;
+            }
+        }
+        EXPECT_GT(asked, 900);
+        // Another pixel, seed or count is not the run's.
+        for (PixelSample other : {PixelSample{3, 124, 20, 48}, PixelSample{4, 123, 20, 48},
+                                  PixelSample{3, 123, 20, 47}}) {
+            const Vec2 expected = sampler->get_2d(other, dim::bounce(0, 2));
+            const Vec2 got = run.get_2d(other, dim::bounce(0, 2));
+            EXPECT_EQ(got.x, expected.x) << name;
+            EXPECT_EQ(got.y, expected.y) << name;
+        }
+    }
+}
+
 TEST(Sampler, ValuesLieInTheHalfOpenUnitInterval) {
     for (const std::string& name : sampler_names()) {
         const auto sampler = make_sampler(name);

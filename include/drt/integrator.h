@@ -50,6 +50,13 @@ class Integrator {
     Color radiance(const Ray& ray, const PixelSample& s, int depth, RayCounts& counts) const;
 
   private:
+    // What the paths of one run of a pixel's samples share.
+    struct PixelWork {
+        RayCounts& counts;
+        RunPoints points;  // of the glossy dimensions
+    };
+
+    Color radiance(const Ray& ray, const PixelSample& s, int depth, PixelWork& work) const;
     // Σ lights at a point: I · max(0, N·ω) · visibility, averaged over each light's shadow rays.
     Color direct_light(const Vec3& point, const Vec3& geometric, const Vec3& shading, double time,
                        const PixelSample& s, int depth, RayCounts& counts) const;
@@ -61,7 +68,7 @@ class Integrator {
     // 0), each redrawn until it leaves on the `side` of the surface (+1 = the normal's side).
     Color scattered(const Vec3& point, const Vec3& geometric, const Vec3& ideal, double sigma,
                     double side, double time, const PixelSample& s, int depth, std::uint32_t kind,
-                    bool refraction, RayCounts& counts) const;
+                    bool refraction, PixelWork& work) const;
 
     const Scene& scene_;
     const RenderPlan& plan_;

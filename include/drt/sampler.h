@@ -79,6 +79,35 @@ class Sampler {
     virtual bool progressive() const { return false; }
 };
 
+// get_2d for the samples of one run of a pixel (first.index, first.index + 1, ...), remembering
+// the run's points of the dimensions its samples keep asking for one at a time: a glossy
+// bounce's, which every camera ray of the pixel that reaches the glossy surface along the same
+// branch of the ray tree asks for. From the kDrawAfter-th request for a dimension on, the whole
+// run's points of it are drawn at once (get_2d_run, cheaper per point) and then looked up. The
+// points are exactly get_2d's.
+class RunPoints {
+  public:
+    RunPoints(const Sampler& sampler, const PixelSample& first, std::uint32_t length)
+        : sampler_(sampler), first_(first), length_(length) {}
+
+    Vec2 get_2d(const PixelSample& s, std::uint32_t dim);
+
+  private:
+    static constexpr std::uint32_t kDrawAfter = 3;
+    static constexpr std::size_t kMaxRemembered = 32;  // dimension and branch pairs
+    struct Remembered {
+        std::uint32_t dim;
+        std::uint64_t path;
+        std::uint32_t requests = 0;
+        std::vector<Vec2> points;  // the run's, once drawn
+    };
+
+    const Sampler& sampler_;
+    PixelSample first_;
+    std::uint32_t length_;
+    std::vector<Remembered> remembered_;
+};
+
 // Independent uniform random numbers: the Monte Carlo baseline.
 class IndependentSampler final : public Sampler {
   public:
