@@ -233,9 +233,12 @@ struct JitteredGrid {
           n((k_ + m - 1) / m),
           key(key_) {}
 
-    std::uint32_t stratum(std::uint32_t j) const { return permute(j, k, key * 0x51633e2du); }
-    std::uint32_t column(std::uint32_t c) const { return permute(c, m, key * 0x68bc21ebu); }
-    std::uint32_t sub_column(std::uint32_t r) const { return permute(r, n, key * 0x02e5be93u); }
+    std::uint32_t stratum(std::uint32_t j) const { return permute(j, k, stratum_key()); }
+    std::uint32_t stratum_key() const { return key * 0x51633e2du; }
+    std::uint32_t column(std::uint32_t c) const { return permute(c, m, column_key()); }
+    std::uint32_t sub_column(std::uint32_t r) const { return permute(r, n, sub_column_key()); }
+    std::uint32_t column_key() const { return key * 0x68bc21ebu; }
+    std::uint32_t sub_column_key() const { return key * 0x02e5be93u; }
 
     Vec2 point(std::uint32_t s, std::uint32_t sx, std::uint32_t sy) const {
         const std::uint64_t h = hash_of(key, s);  // hash_of(key, s, c) continues it
@@ -244,6 +247,64 @@ struct JitteredGrid {
         return {(sx + (sy + jx) / n) / m, (s + jy) / k};
     }
 };
+
+// Exactly double(x) for x < 2^52, in integer operations that vectorise (x86 before AVX-512 has
+// no instruction converting 64-bit integers to doubles).
+double small_to_double(std::uint64_t x) {
+    return std::bit_cast<double>(x | 0x4330000000000000ULL) - 0x1.0p52;
+}
+
+// to_unit(h), in operations that vectorise: h >> 11 < 2^53 in two exact halves, whose sum is
+// exact too.
+double unit_of(std::uint64_t h) {
+    const std::uint64_t x = h >> 11;
+    return (small_to_double(x >> 32) * 0x1.0p32 + small_to_double(x & 0xffffffffu)) * 0x1.0p-53;
+}
+
+// permute(first + i, n, key) into out[i]. Every index takes a step, and then those still
+// outside [0, n) another, pass after pass over all of them (the others left as they are) until
+// none is: the same walks as permute's, in loops that vectorise, where a walk per index would
+// mispredict its end about once per index.
+__attribute__((target_clones("avx2", "default"))) void permute_run(std::uint32_t first,
+                                                                   std::uint32_t n,
+                                                                   std::uint32_t key,
+                                                                   std::uint32_t* out,
+                                                                   std::size_t count) {
+    const std::uint32_t w = permute_mask(n);
+    std::uint32_t walking = 0;  // an integer: a bool's |= keeps the loop from vectorising
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::uint32_t x = permute_step(first + static_cast<std::uint32_t>(i), w, key);
+        out[i] = x;
+        walking |= static_cast<std::uint32_t>(x >= n);
+    }
+    while (walking != 0) {
+        walking = 0;
+        for (std::size_t i = 0; i < count; ++i) {
+            const std::uint32_t stepped = permute_step(out[i], w, key);
+            const std::uint32_t x = out[i] >= n ? stepped : out[i];
+            out[i] = x;
+            walking |= static_cast<std::uint32_t>(x >= n);
+        }
+    }
+    for (std::size_t i = 0; i < count; ++i) out[i] = permute_rotate(out[i], n, key);
+}
+
+// grid.point(s, column_of[s], sub_column_of[s]) for each stratum s = strata[i], into out[i].
+__attribute__((target_clones("avx2", "default"))) void grid_points(
+    const JitteredGrid& grid, const std::uint32_t* strata, const std::uint32_t* column_of,
+    const std::uint32_t* sub_column_of, Vec2* out, std::size_t count) {
+    const std::uint64_t h0 = hash_of(grid.key);  // hash_of(key, s) continues it
+    const double m = grid.m, n = grid.n, k = grid.k;
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::uint32_t s = strata[i];
+        const std::uint64_t h = hash_combine(h0, s);
+        const double jx = unit_of(hash_combine(h, 1));
+        const double jy = unit_of(hash_combine(h, 2));
+        out[i] = {
+            (small_to_double(column_of[s]) + (small_to_double(sub_column_of[s]) + jx) / n) / m,
+            (small_to_double(s) + jy) / k};
+    }
+}
 
 }  // namespace
 
@@ -265,11 +326,24 @@ void multi_jittered_run(std::uint32_t first, std::uint32_t k, std::uint32_t key,
         return;
     }
     std::array<std::uint32_t, kTabulated> columns, sub_columns;
-    for (std::uint32_t c = 0; c < grid.m; ++c) columns[c] = grid.column(c);
-    for (std::uint32_t r = 0; r < grid.n; ++r) sub_columns[r] = grid.sub_column(r);
-    for (std::size_t i = 0; i < out.size(); ++i) {
-        const std::uint32_t s = grid.stratum(first + static_cast<std::uint32_t>(i));
-        out[i] = grid.point(s, columns[s % grid.m], sub_columns[s / grid.m]);
+    permute_run(0, grid.m, grid.column_key(), columns.data(), grid.m);
+    permute_run(0, grid.n, grid.sub_column_key(), sub_columns.data(), grid.n);
+    // Each stratum's column and sub-column, and the run's strata, a batch at a time.
+    constexpr std::size_t kBatch = 256;
+    std::array<std::uint32_t, kTabulated * kTabulated> column_of, sub_column_of;  // k <= m n
+    for (std::uint32_t row = 0, s = 0; row < grid.n; ++row) {
+        for (std::uint32_t col = 0; col < grid.m && s < k; ++col, ++s) {
+            column_of[s] = columns[col];
+            sub_column_of[s] = sub_columns[row];
+        }
+    }
+    std::array<std::uint32_t, kBatch> strata;
+    for (std::size_t done = 0; done < out.size(); done += kBatch) {
+        const std::size_t count = std::min(kBatch, out.size() - done);
+        permute_run(first + static_cast<std::uint32_t>(done), k, grid.stratum_key(), strata.data(),
+                    count);
+        grid_points(grid, strata.data(), column_of.data(), sub_column_of.data(), out.data() + done,
+                    count);
     }
 }
 
@@ -336,12 +410,6 @@ void shuffle(std::span<std::uint32_t> out, Digits& digits) {
     for (auto c = static_cast<std::uint32_t>(out.size()); c > 1; --c) {
         std::swap(out[c - 1], out[digits.below(c)]);
     }
-}
-
-// Exactly double(x) for x < 2^52, in integer operations that vectorise (x86 before AVX-512 has
-// no instruction converting 64-bit integers to doubles).
-double small_to_double(std::uint64_t x) {
-    return std::bit_cast<double>(x | 0x4330000000000000ULL) - 0x1.0p52;
 }
 
 // A 32-bit bijective hash with full avalanche (Wellons' "lowbias32" constants); 32-bit

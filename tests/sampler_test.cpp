@@ -127,7 +127,7 @@ TEST(Sampler, SetsAtOnceEqualPointsOneByOne) {
 TEST(Sampler, RunsAtOnceEqualPointsOneByOne) {
     for (const std::string& name : sampler_names()) {
         const auto sampler = make_sampler(name);
-        for (const std::uint32_t count : {1u, 7u, 82u, 100u}) {
+        for (const std::uint32_t count : {1u, 7u, 82u, 100u, 1000u}) {
             const PixelSample first{9, 40, count / 4, count, 77};
             std::vector<Vec2> points(count - count / 4);
             sampler->get_2d_run(first, dim::kPixel, points);
