@@ -371,7 +371,7 @@ struct SegmentCone {
         // angle(v, axis) <= a + b, that is along >= |v| cos(a + b) = cos a |v| cos b - sin a r,
         // where |v| cos b = sqrt(|v|² - r²) (0 when the apex is within the slack of the ball,
         // which then looks like a half-space: missed when the whole light is above its plane).
-        const double tangent = std::sqrt(std::max(0.0, d2 - r * r));
+        const double tangent = std::sqrt(positive_part(d2 - r * r));
         return along >= cos_a * tangent - sin_a * r - kSlack * (tangent + r);
     }
 };
@@ -383,14 +383,18 @@ Occluders Bvh::gather_occluders(const Vec3& origin, const Ball& target, double t
     const double slack =
         kSlack * (max_abs_component(origin) + max_abs_component(target.centre) + target.radius);
     const Vec3 w = target.centre - origin;
-    const double reach = length(w);
+    const double d2 = dot(w, w);
+    // The distance and the tangent's length side by side rather than one after the other: the
+    // cone's cosine sqrt(1 - sin²) would wait on the sine, which waits on the distance.
+    const double reach = std::sqrt(d2);
+    const double tangent = std::sqrt(positive_part(d2 - target.radius * target.radius));
     // From inside the ball, or next to it, segments go every way: keep everything.
     if (!(reach > target.radius + slack)) return found;
-    const double sin_a = target.radius / reach;
+    const double inverse = 1.0 / reach;
     const SegmentCone cone{origin,
-                           w / reach,
-                           sin_a,
-                           std::sqrt(std::max(0.0, 1.0 - sin_a * sin_a)),
+                           w * inverse,
+                           target.radius * inverse,
+                           tangent * inverse,
                            reach + target.radius + slack,
                            slack};
 

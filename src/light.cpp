@@ -1,8 +1,6 @@
 #include "drt/light.h"
 
-#include <bit>
 #include <cmath>
-#include <cstdint>
 
 #include "drt/sphere.h"
 
@@ -15,14 +13,6 @@ LightSample PointLight::sample(const Vec3& x, Vec2) const {
 }
 
 namespace {
-
-// max(0, v) on the bits (negative numbers have the sign bit set and become +0): with a
-// comparison, the compiler moves the following square root into a branch, which keeps a loop
-// from vectorising.
-double positive_part(double v) {
-    const auto bits = std::bit_cast<std::uint64_t>(v);
-    return std::bit_cast<double>(bits & ((bits >> 63) - 1));
-}
 
 // The cone of directions a sphere subtends from a point outside it: what every sample from that
 // point shares.

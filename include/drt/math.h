@@ -76,6 +76,14 @@ inline double max_abs_component(const Vec3& v) {
     return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
 }
 
+// max(0, v) on the bits (negative numbers have the sign bit set and become +0): with a
+// comparison, the compiler moves a following square root into a branch, which keeps a loop
+// from vectorising and is mispredicted where the sign varies.
+inline double positive_part(double v) {
+    const auto bits = std::bit_cast<std::uint64_t>(v);
+    return std::bit_cast<double>(bits & ((bits >> 63) - 1));
+}
+
 struct SinCos {
     double sin, cos;
 };
