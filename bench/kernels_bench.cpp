@@ -3,6 +3,7 @@
 #include <benchmark/benchmark.h>
 
 #include <array>
+#include <vector>
 
 #include "bench_world.h"
 #include "drt/light.h"
@@ -52,6 +53,23 @@ void BM_Sample2d(benchmark::State& state, const char* name) {
 }
 BENCHMARK_CAPTURE(BM_Sample2d, random, "random");
 BENCHMARK_CAPTURE(BM_Sample2d, stratified, "stratified");
+
+// A whole pixel's camera samples in 2-D at once (range(0) of them), as the integrator draws
+// them, per point.
+void BM_Sample2dRun(benchmark::State& state, const char* name) {
+    const auto sampler = make_sampler(name);
+    const auto count = static_cast<std::uint32_t>(state.range(0));
+    std::vector<Vec2> points(count);
+    PixelSample s{0, 0, 0, count};
+    for (auto _ : state) {
+        sampler->get_2d_run(s, dim::kPixel, points);
+        benchmark::DoNotOptimize(points.data());
+        ++s.pixel;
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * count));
+}
+BENCHMARK_CAPTURE(BM_Sample2dRun, random, "random")->Arg(82);
+BENCHMARK_CAPTURE(BM_Sample2dRun, stratified, "stratified")->Arg(82);
 
 // The points of one shading point's shadow-ray set (k = range(0) points), per point.
 void BM_SampleSet(benchmark::State& state, const char* name) {

@@ -66,25 +66,19 @@ struct Cone {
     }
 };
 
-// Cone::sample for every point. The AVX2 clone, chosen at run time where the processor has it,
-// does the same IEEE operations (no fused multiply-adds), four lanes at a time, so its results
-// are bit-identical to the scalar sample's (tests/light_test.cpp checks) and images do not
-// depend on the machine.
-__attribute__((target_clones("avx2", "default"))) void sample_cone_batch(const Cone& cone,
-                                                                         const Vec2* u,
-                                                                         LightSample* out,
-                                                                         std::size_t count) {
+// Cone::sample for every point. Vectorised, it does the same IEEE operations (no fused
+// multiply-adds) several lanes at a time, so its results are bit-identical to the scalar
+// sample's (tests/light_test.cpp checks) and images do not depend on the machine.
+DRT_VECTORISED void sample_cone_batch(const Cone& cone, const Vec2* u, LightSample* out,
+                                      std::size_t count) {
     for (std::size_t i = 0; i < count; ++i) out[i] = cone.sample(u[i]);
 }
 
 // lit_cosine for every point. The cosine with a normal N is N·t x + N·b y + N·n cos θ: three
 // products per normal, where building the direction first would take nine more. (So the last
 // bits may differ from those of lit_cosine(sample(...).dir, ...).)
-__attribute__((target_clones("avx2", "default"))) void lit_cosine_batch(const Cone& cone,
-                                                                        const Vec3& shading,
-                                                                        const Vec3& geometric,
-                                                                        const Vec2* u, double* out,
-                                                                        std::size_t count) {
+DRT_VECTORISED void lit_cosine_batch(const Cone& cone, const Vec3& shading, const Vec3& geometric,
+                                     const Vec2* u, double* out, std::size_t count) {
     const Frame& f = cone.frame;
     const Vec3 s{dot(shading, f.t), dot(shading, f.b), dot(shading, f.n)};
     const Vec3 g{dot(geometric, f.t), dot(geometric, f.b), dot(geometric, f.n)};

@@ -265,11 +265,8 @@ double unit_of(std::uint64_t h) {
 // outside [0, n) another, pass after pass over all of them (the others left as they are) until
 // none is: the same walks as permute's, in loops that vectorise, where a walk per index would
 // mispredict its end about once per index.
-__attribute__((target_clones("avx2", "default"))) void permute_run(std::uint32_t first,
-                                                                   std::uint32_t n,
-                                                                   std::uint32_t key,
-                                                                   std::uint32_t* out,
-                                                                   std::size_t count) {
+DRT_VECTORISED void permute_run(std::uint32_t first, std::uint32_t n, std::uint32_t key,
+                                std::uint32_t* out, std::size_t count) {
     const std::uint32_t w = permute_mask(n);
     std::uint32_t walking = 0;  // an integer: a bool's |= keeps the loop from vectorising
     for (std::size_t i = 0; i < count; ++i) {
@@ -290,9 +287,9 @@ __attribute__((target_clones("avx2", "default"))) void permute_run(std::uint32_t
 }
 
 // grid.point(s, column_of[s], sub_column_of[s]) for each stratum s = strata[i], into out[i].
-__attribute__((target_clones("avx2", "default"))) void grid_points(
-    const JitteredGrid& grid, const std::uint32_t* strata, const std::uint32_t* column_of,
-    const std::uint32_t* sub_column_of, Vec2* out, std::size_t count) {
+DRT_VECTORISED void grid_points(const JitteredGrid& grid, const std::uint32_t* strata,
+                                const std::uint32_t* column_of, const std::uint32_t* sub_column_of,
+                                Vec2* out, std::size_t count) {
     const std::uint64_t h0 = hash_of(grid.key);  // hash_of(key, s) continues it
     const double m = grid.m, n = grid.n, k = grid.k;
     for (std::size_t i = 0; i < count; ++i) {
@@ -424,12 +421,11 @@ constexpr std::uint32_t hash32(std::uint32_t x) {
 
 // `count` points of a set of k strata in which stratum s has the cell cell_of[s] of the m x n
 // grid, from stratum `start` on: x = (cell + jx) / (m n), y = (s + jy) / k, the jitters keyed by
-// `key`. The jitters' 32 bits keep both below 1 for any
-// k < 2^20, and the clamp beyond. The AVX2 clone does the same operations as the default, eight
-// or four lanes at a time, so its points are bit-identical.
-__attribute__((target_clones("avx2", "default"))) void jittered_points(
-    std::uint64_t key, std::uint32_t start, std::uint32_t k, const std::uint32_t* cell_of,
-    double inv_cells, double inv_k, Vec2* out, std::size_t count) {
+// `key`. The jitters' 32 bits keep both below 1 for any k < 2^20, and the clamp beyond.
+// Vectorised, it does the same operations several lanes at a time: its points are bit-identical.
+DRT_VECTORISED void jittered_points(std::uint64_t key, std::uint32_t start, std::uint32_t k,
+                                    const std::uint32_t* cell_of, double inv_cells, double inv_k,
+                                    Vec2* out, std::size_t count) {
     constexpr double kBelowOne = 0x1.fffffffffffffp-1;
     const auto key_x = static_cast<std::uint32_t>(key),
                key_y = static_cast<std::uint32_t>(key >> 32);

@@ -39,7 +39,7 @@ TEST(LightPoint, SampleIsTheExactDirectionAndDistance) {
     EXPECT_FALSE(light.intersect({{0, 0, 0}, {0.8, 0.6, 0}}, {}));
 }
 
-// The batch is vectorised (an AVX2 clone where the processor has one): it must give exactly
+// The batch is vectorised (and in a portable build has an AVX2 clone): it must give exactly
 // the scalar answers, or images would depend on the machine and on how rays are grouped.
 TEST(LightSphere, BatchSamplesAreBitIdenticalToSingleOnes) {
     const SphereLight light({300, 450, 300}, 40, kWhite, false);
