@@ -28,23 +28,10 @@ struct Cone {
           cos_max(std::sqrt(std::max(0.0, 1.0 - r2 / d2))),
           frame(Frame::around((centre - x) / d)) {}
 
-    // A direction in the cone is t x + b y + n cos θ in the cone's frame; sin²θ is kept for the
-    // distance.
-    struct Coordinates {
-        double x, y, cos_t, sin2_t;
-    };
+    // A sample's direction is t x + b y + n cos θ in the cone's frame.
+    ConeCoordinates coordinates(Vec2 u) const { return cone_coordinates(u, cos_max); }
 
-    // sample_cone(u, cos_max) in the frame, without a branch or a table look-up, so that a loop
-    // of these vectorises (sample_cone_batch, lit_cosine_batch).
-    Coordinates coordinates(Vec2 u) const {
-        const double cos_t = 1.0 - u.x * (1.0 - cos_max);
-        const double sin2_t = positive_part(1.0 - cos_t * cos_t);
-        const double sin_t = std::sqrt(sin2_t);
-        const SinCos phi = sincos_turns(u.y);
-        return {sin_t * phi.cos, sin_t * phi.sin, cos_t, sin2_t};
-    }
-
-    Vec3 direction(const Coordinates& c) const {
+    Vec3 direction(const ConeCoordinates& c) const {
         const Vec3& t = frame.t;
         const Vec3& b = frame.b;
         const Vec3& n = frame.n;
@@ -56,12 +43,12 @@ struct Cone {
     // with b = d cos θ, the distance to the point nearest the centre. It depends on θ alone, so
     // its square root need not wait for the azimuth. At the cone's rim the ray grazes the
     // sphere and rounding may miss, where b itself is exact enough.
-    double distance(const Coordinates& c) const {
+    double distance(const ConeCoordinates& c) const {
         return d * c.cos_t - std::sqrt(positive_part(r2 - d2 * c.sin2_t));
     }
 
     LightSample sample(Vec2 u) const {
-        const Coordinates c = coordinates(u);
+        const ConeCoordinates c = coordinates(u);
         return {direction(c), distance(c)};
     }
 };
@@ -83,7 +70,7 @@ DRT_VECTORISED void lit_cosine_batch(const Cone& cone, const Vec3& shading, cons
     const Vec3 s{dot(shading, f.t), dot(shading, f.b), dot(shading, f.n)};
     const Vec3 g{dot(geometric, f.t), dot(geometric, f.b), dot(geometric, f.n)};
     for (std::size_t i = 0; i < count; ++i) {
-        const Cone::Coordinates c = cone.coordinates(u[i]);
+        const ConeCoordinates c = cone.coordinates(u[i]);
         const double cosine = s.x * c.x + s.y * c.y + s.z * c.cos_t;
         out[i] = (cosine > 0) & (g.x * c.x + g.y * c.y + g.z * c.cos_t > 0) ? cosine : 0.0;
     }

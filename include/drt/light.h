@@ -1,7 +1,6 @@
 // Lights: spheres of uniform radiance (the thesis's round lights) and their limit, the point light.
 #pragma once
 
-#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <span>
@@ -96,14 +95,26 @@ inline double lit_cosine(const Vec3& dir, const Vec3& shading, const Vec3& geome
     return (cosine > 0) & (dot(geometric, dir) > 0) ? cosine : 0.0;
 }
 
-// Uniformly distributed direction in the cone of half-angle acos(cos_max) about +z. Inline: one
-// per shadow ray.
-inline Vec3 sample_cone(Vec2 u, double cos_max) {
+// A direction in the cone of half-angle acos(cos_max) about +z, uniformly distributed over it
+// for u uniform over the square, as its coordinates x, y, cos θ, with sin²θ besides (a light's
+// distance needs it). Inline and without a branch or a table look-up: one per shadow ray, in
+// loops that vectorise.
+struct ConeCoordinates {
+    double x, y, cos_t, sin2_t;
+};
+inline ConeCoordinates cone_coordinates(Vec2 u, double cos_max) {
     // Uniform in solid angle means uniform in cos(theta) between cos_max and 1.
     const double cos_t = 1.0 - u.x * (1.0 - cos_max);
-    const double sin_t = std::sqrt(std::max(0.0, 1.0 - cos_t * cos_t));
+    const double sin2_t = positive_part(1.0 - cos_t * cos_t);
+    const double sin_t = std::sqrt(sin2_t);
     const SinCos phi = sincos_turns(u.y);
-    return {sin_t * phi.cos, sin_t * phi.sin, cos_t};
+    return {sin_t * phi.cos, sin_t * phi.sin, cos_t, sin2_t};
+}
+
+// The same direction as a vector.
+inline Vec3 sample_cone(Vec2 u, double cos_max) {
+    const ConeCoordinates c = cone_coordinates(u, cos_max);
+    return {c.x, c.y, c.cos_t};
 }
 
 }  // namespace drt
