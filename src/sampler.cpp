@@ -220,6 +220,19 @@ void IndependentSampler::get_2d_set(const PixelSample& s, std::uint32_t dim, std
 
 namespace {
 
+// Exactly double(x) for x < 2^52, in integer operations that vectorise (x86 before AVX-512 has
+// no instruction converting 64-bit integers to doubles).
+double small_to_double(std::uint64_t x) {
+    return std::bit_cast<double>(x | 0x4330000000000000ULL) - 0x1.0p52;
+}
+
+// to_unit(h), in operations that vectorise: h >> 11 < 2^53 in two exact halves, whose sum is
+// exact too.
+double unit_of(std::uint64_t h) {
+    const std::uint64_t x = h >> 11;
+    return (small_to_double(x >> 32) * 0x1.0p32 + small_to_double(x & 0xffffffffu)) * 0x1.0p-53;
+}
+
 // Kensler's pattern for any k: an m x n grid of cells, m*n >= k, as square as possible. Point
 // s (a shuffled j) takes its own stratum of y among k strata, and its own column sx and
 // sub-column sy of x among m*n; when k = m*n each cell of the grid holds exactly one point.
@@ -240,26 +253,19 @@ struct JitteredGrid {
     std::uint32_t column_key() const { return key * 0x68bc21ebu; }
     std::uint32_t sub_column_key() const { return key * 0x02e5be93u; }
 
-    Vec2 point(std::uint32_t s, std::uint32_t sx, std::uint32_t sy) const {
-        const std::uint64_t h = hash_of(key, s);  // hash_of(key, s, c) continues it
-        const double jx = to_unit(hash_combine(h, 1));
-        const double jy = to_unit(hash_combine(h, 2));
-        return {(sx + (sy + jx) / n) / m, (s + jy) / k};
+    // The hash the points' jitters continue: hash_of(key, s, c) = hash_combine(hash_combine(
+    // key_hash(), s), c).
+    std::uint64_t key_hash() const { return hash_of(key); }
+
+    // The point of stratum s in column sx and sub-column sy, in operations that vectorise.
+    Vec2 point(std::uint64_t key_hash, std::uint32_t s, std::uint32_t sx, std::uint32_t sy) const {
+        const std::uint64_t h = hash_combine(key_hash, s);
+        const double jx = unit_of(hash_combine(h, 1));
+        const double jy = unit_of(hash_combine(h, 2));
+        return {(small_to_double(sx) + (small_to_double(sy) + jx) / n) / m,
+                (small_to_double(s) + jy) / k};
     }
 };
-
-// Exactly double(x) for x < 2^52, in integer operations that vectorise (x86 before AVX-512 has
-// no instruction converting 64-bit integers to doubles).
-double small_to_double(std::uint64_t x) {
-    return std::bit_cast<double>(x | 0x4330000000000000ULL) - 0x1.0p52;
-}
-
-// to_unit(h), in operations that vectorise: h >> 11 < 2^53 in two exact halves, whose sum is
-// exact too.
-double unit_of(std::uint64_t h) {
-    const std::uint64_t x = h >> 11;
-    return (small_to_double(x >> 32) * 0x1.0p32 + small_to_double(x & 0xffffffffu)) * 0x1.0p-53;
-}
 
 // permute(first + i, n, key) into out[i]. Every index takes a step, and then those still
 // outside [0, n) another, pass after pass over all of them (the others left as they are) until
@@ -290,16 +296,10 @@ DRT_VECTORISED void permute_run(std::uint32_t first, std::uint32_t n, std::uint3
 DRT_VECTORISED void grid_points(const JitteredGrid& grid, const std::uint32_t* strata,
                                 const std::uint32_t* column_of, const std::uint32_t* sub_column_of,
                                 Vec2* out, std::size_t count) {
-    const std::uint64_t h0 = hash_of(grid.key);  // hash_of(key, s) continues it
-    const double m = grid.m, n = grid.n, k = grid.k;
+    const std::uint64_t key_hash = grid.key_hash();
     for (std::size_t i = 0; i < count; ++i) {
         const std::uint32_t s = strata[i];
-        const std::uint64_t h = hash_combine(h0, s);
-        const double jx = unit_of(hash_combine(h, 1));
-        const double jy = unit_of(hash_combine(h, 2));
-        out[i] = {
-            (small_to_double(column_of[s]) + (small_to_double(sub_column_of[s]) + jx) / n) / m,
-            (small_to_double(s) + jy) / k};
+        out[i] = grid.point(key_hash, s, column_of[s], sub_column_of[s]);
     }
 }
 
@@ -308,7 +308,7 @@ DRT_VECTORISED void grid_points(const JitteredGrid& grid, const std::uint32_t* s
 Vec2 multi_jittered(std::uint32_t j, std::uint32_t k, std::uint32_t key) {
     const JitteredGrid grid(k, key);
     const std::uint32_t s = grid.stratum(j);
-    return grid.point(s, grid.column(s % grid.m), grid.sub_column(s / grid.m));
+    return grid.point(grid.key_hash(), s, grid.column(s % grid.m), grid.sub_column(s / grid.m));
 }
 
 void multi_jittered_run(std::uint32_t first, std::uint32_t k, std::uint32_t key,
