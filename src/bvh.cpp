@@ -158,8 +158,10 @@ std::uint32_t Bvh::build(std::vector<Build>& items, std::uint32_t begin, std::ui
         std::array<Bounds, kBins> bin_bounds{};
         std::array<std::uint32_t, kBins> bin_counts{};
         auto bin_of = [&](const Build& item) {
-            const int b = static_cast<int>(kBins * (item.bounds.centre()[axis] - lo) / width);
-            return std::clamp(b, 0, kBins - 1);
+            // Clamped before the conversion, which would be undefined for an infinite or NaN
+            // position (bounds of astronomically large objects); NaN goes to bin 0.
+            const double b = kBins * (item.bounds.centre()[axis] - lo) / width;
+            return b < kBins - 1 ? (b > 0 ? static_cast<int>(b) : 0) : kBins - 1;
         };
         for (std::uint32_t i = begin; i < end; ++i) {
             const int b = bin_of(items[i]);

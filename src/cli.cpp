@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -11,18 +12,22 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <new>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "drt/atomic_file.h"
 #include "drt/compare.h"
 #include "drt/converge.h"
 #include "drt/image.h"
+#include "drt/limits.h"
 #include "drt/render_plan.h"
 #include "drt/renderer.h"
 #include "drt/sampler.h"
 #include "drt/scene_loader.h"
+#include "drt/text.h"
 
 namespace drt {
 
@@ -34,29 +39,77 @@ constexpr int kOk = 0;
 constexpr int kFailed = 1;
 constexpr int kBadInput = 2;
 
+// A setting past one of the limits of limits.h once the options are applied: bad input.
+class LimitError : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+// An integer option from `lowest` to `limit`. CLI11's own range checks print a double's bounds in
+// full (309 digits) and its unsigned conversion takes -1 for 2^64 - 1.
+CLI::Validator integer_in(long long lowest, unsigned long long limit) {
+    const std::string rule =
+        "must be an integer from " + std::to_string(lowest) + " to " + std::to_string(limit);
+    return CLI::Validator(
+        [=](std::string& text) -> std::string {
+            const char* end = text.data() + text.size();
+            bool ok = false;
+            if (lowest >= 0) {
+                unsigned long long v = 0;
+                const auto [ptr, ec] = std::from_chars(text.data(), end, v);
+                ok = ec == std::errc() && ptr == end &&
+                     v >= static_cast<unsigned long long>(lowest) && v <= limit;
+            } else {
+                long long v = 0;
+                const auto [ptr, ec] = std::from_chars(text.data(), end, v);
+                ok = ec == std::errc() && ptr == end && v >= lowest &&
+                     static_cast<unsigned long long>(v) <= limit;
+            }
+            return ok ? std::string() : rule + ", got " + printable(abbreviated(text));
+        },
+        "INT in [" + std::to_string(lowest) + ", " + std::to_string(limit) + "]");
+}
+
+// A finite number above zero (CLI::PositiveNumber lets "nan" and "inf" through).
+CLI::Validator finite_positive() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            char* end = nullptr;
+            const double v = std::strtod(text.c_str(), &end);
+            const bool ok = !text.empty() && *end == '\0' && std::isfinite(v) && v > 0;
+            return ok ? std::string()
+                      : "must be a finite positive number, got " + printable(abbreviated(text));
+        },
+        "POSITIVE");
+}
+
 // Command-line settings that override the scene's <Image> and <Render>.
 struct Overrides {
     std::optional<int> spp, shadow_rays, width, height, glossy_rays, max_depth;
-    std::optional<std::uint64_t> seed;
+    std::optional<std::uint64_t> seed;  // from a text the validator has checked, not CLI11's
     std::optional<std::string> sampler;
     std::optional<double> scale;
 
     void add_to(CLI::App& app) {
         app.add_option("--spp", spp, "Camera samples per pixel (overrides Render Samples)")
-            ->check(CLI::PositiveNumber);
+            ->check(integer_in(1, kMaxSamples));
         app.add_option("--shadow-rays", shadow_rays, "Overrides Render ShadowRays")
-            ->check(CLI::PositiveNumber);
-        app.add_option("--width", width, "Overrides Image Width")->check(CLI::PositiveNumber);
-        app.add_option("--height", height, "Overrides Image Height")->check(CLI::PositiveNumber);
+            ->check(integer_in(1, kMaxRaysPerPoint));
+        app.add_option("--width", width, "Overrides Image Width")
+            ->check(integer_in(1, kMaxImageSide));
+        app.add_option("--height", height, "Overrides Image Height")
+            ->check(integer_in(1, kMaxImageSide));
         app.add_option("--scale", scale,
                        "Multiplies the image size, keeping the framing (applied after --width and "
                        "--height)")
-            ->check(CLI::PositiveNumber);
-        app.add_option("--seed", seed, "Overrides Render Seed");
+            ->check(finite_positive());
+        // Like the scene's Seed: a negative number is an error, not 2^64 minus it.
+        app.add_option("--seed", seed, "Overrides Render Seed")
+            ->check(integer_in(0, std::numeric_limits<std::uint64_t>::max()));
         app.add_option("--glossy-rays", glossy_rays, "Overrides Render GlossyRays")
-            ->check(CLI::PositiveNumber);
+            ->check(integer_in(1, kMaxRaysPerPoint));
         app.add_option("--max-depth", max_depth, "Overrides Render MaxDepth")
-            ->check(CLI::NonNegativeNumber);
+            ->check(integer_in(0, kMaxDepthLimit));
         app.add_option("--sampler", sampler, "Sampler: stratified (default), random or sobol")
             ->check(CLI::IsMember(sampler_names()));
     }
@@ -67,8 +120,16 @@ struct Overrides {
         if (width) s.width = *width;
         if (height) s.height = *height;
         if (scale) {
-            s.width = std::max(1, static_cast<int>(std::lround(s.width * *scale)));
-            s.height = std::max(1, static_cast<int>(std::lround(s.height * *scale)));
+            // In double, checked before converting: 1e9 times a side does not fit an int.
+            const double w = std::max(1.0, std::round(s.width * *scale));
+            const double h = std::max(1.0, std::round(s.height * *scale));
+            if (w > kMaxImageSide || h > kMaxImageSide) {
+                throw LimitError("--scale " + short_number(*scale) + " makes the image " +
+                                 short_number(w) + "x" + short_number(h) + ", past the limit of " +
+                                 std::to_string(kMaxImageSide) + " pixels a side");
+            }
+            s.width = static_cast<int>(w);
+            s.height = static_cast<int>(h);
             s.pixel_plane_unit /= *scale;
         }
         if (seed) s.seed = *seed;
@@ -117,6 +178,14 @@ std::string json_bool(bool b) {
     return b ? "true" : "false";
 }
 
+// JSON has no NaN or infinity: those become null.
+std::string json_number(double v) {
+    if (!std::isfinite(v)) return "null";
+    std::ostringstream text;
+    text << std::setprecision(6) << v;
+    return text.str();
+}
+
 std::string json_string(const std::string& s) {
     std::string out = "\"";
     for (char c : s) {
@@ -139,7 +208,7 @@ std::string stats_json(const Scene& scene, const RenderResult& r) {
     std::ostringstream j;
     j << std::setprecision(6);
     j << "{\n  \"scene\": " << json_string(scene.path) << ",\n"
-      << "  \"seconds\": " << r.stats.seconds << ",\n"
+      << "  \"seconds\": " << json_number(r.stats.seconds) << ",\n"
       << "  \"width\": " << s.width << ", \"height\": " << s.height
       << ", \"samples_per_pixel\": " << s.samples << ",\n"
       << "  \"shadow_rays\": " << s.shadow_rays << ", \"glossy_rays\": " << s.glossy_rays
@@ -150,10 +219,11 @@ std::string stats_json(const Scene& scene, const RenderResult& r) {
       << ", \"reflection\": " << rays.reflection << ", \"refraction\": " << rays.refraction
       << ", \"total\": " << rays.total() << "},\n"
       << "  \"million_rays_per_second\": "
-      << (r.stats.seconds > 0 ? rays.total() / r.stats.seconds / 1e6 : 0.0) << ",\n"
-      << "  \"mean_spp\": " << double(r.stats.samples) / (double(s.width) * s.height) << ",\n";
+      << json_number(r.stats.seconds > 0 ? rays.total() / r.stats.seconds / 1e6 : 0.0) << ",\n"
+      << "  \"mean_spp\": " << json_number(double(r.stats.samples) / (double(s.width) * s.height))
+      << ",\n";
     if (const auto& a = r.stats.adaptive) {
-        j << "  \"adaptive\": {\"noise_threshold\": " << a->noise_threshold
+        j << "  \"adaptive\": {\"noise_threshold\": " << json_number(a->noise_threshold)
           << ", \"min_spp\": " << a->min_samples << ", \"max_spp\": " << s.samples
           << ", \"pixels_converged\": " << r.stats.pixels_converged << "},\n";
     }
@@ -166,21 +236,9 @@ std::string stats_json(const Scene& scene, const RenderResult& r) {
     return j.str();
 }
 
-// Writes text through a temporary file and a rename, like the images.
+// Writes text and a final newline through a temporary file and a rename, like the images.
 void write_text_atomically(const fs::path& path, const std::string& text) {
-    const fs::path tmp =
-        path.parent_path() / ("." + path.filename().string() + ".tmp-" + std::to_string(getpid()));
-    {
-        std::ofstream f(tmp, std::ios::binary);
-        f << text << "\n";
-        f.close();
-        if (!f) {
-            std::error_code ignored;
-            fs::remove(tmp, ignored);
-            throw std::runtime_error(path.string() + ": cannot write file");
-        }
-    }
-    fs::rename(tmp, path);
+    replace_file(path, text + "\n");
 }
 
 struct SceneOutcome {
@@ -202,10 +260,10 @@ struct AdaptiveFlags {
             app.add_option("--noise-threshold", noise_threshold,
                            "Adaptive sampling: a pixel stops once the standard error of its mean "
                            "luminance is below X; --spp is the maximum")
-                ->check(CLI::PositiveNumber);
+                ->check(finite_positive());
         app.add_option("--min-spp", min_spp,
                        "Adaptive sampling: samples every pixel takes first (default 16)")
-            ->check(CLI::PositiveNumber)
+            ->check(integer_in(1, kMaxSamples))
             ->needs(threshold);
     }
     std::optional<AdaptiveSampling> settings() const {
@@ -222,22 +280,34 @@ struct RenderJob {
     bool progress = false;
 };
 
+// Channel values that are NaN or infinite: radiance beyond the float range (a light of 1e39).
+std::size_t count_nonfinite(const Image& image) {
+    return static_cast<std::size_t>(std::count_if(image.rgb.begin(), image.rgb.end(),
+                                                  [](float v) { return !std::isfinite(v); }));
+}
+
+// One scene, start to end. Everything that can go wrong ends here as a message and a status, so
+// that a batch goes on with its other scenes: this is the job boundary.
 SceneOutcome render_one(const std::string& scene_path, const fs::path& output, const RenderJob& job,
                         std::ostream& err) {
     SceneOutcome outcome;
     outcome.scene = scene_path;
+    const std::string name = printable(scene_path);
     try {
         format_for_path(output);  // refuse an unknown extension before spending time rendering
         LoadedScene loaded = load_scene(scene_path);
         for (const std::string& w : loaded.warnings) err << w << "\n";
         Scene& scene = loaded.scene;
         job.overrides.apply(scene.settings);
+        if (const auto problem = render_limit_problem(scene.settings, job.threads)) {
+            throw LimitError(*problem);
+        }
         RenderOptions options;
         options.threads = job.threads;
         options.adaptive = job.adaptive.settings();
         std::optional<ProgressDisplay> display;
         if (job.progress) {
-            display.emplace(err, fs::path(scene_path).filename().string());
+            display.emplace(err, printable(fs::path(scene_path).filename().string()));
             options.on_progress = [&](double done) { (*display)(done); };
         }
         const RenderResult result = render(scene, options);
@@ -256,10 +326,17 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output, c
             return outcome;
         }
         if (!job.quiet) {
-            err << "drt: wrote " << output.string() << " (" << outcome.width << "x"
+            err << "drt: wrote " << printable(output.string()) << " (" << outcome.width << "x"
                 << outcome.height << ", " << outcome.samples << " spp, " << std::fixed
                 << std::setprecision(2) << outcome.seconds << " s)\n"
                 << std::defaultfloat;
+        }
+        // Written all the same, for inspection, but not a success: no pixel may be silently lost.
+        if (const std::size_t bad = count_nonfinite(result.image)) {
+            err << "drt: " << name << ": " << bad << " of " << result.image.rgb.size()
+                << " channel values are not finite (radiance beyond the float range: a light, "
+                   "background or ambient too bright?)\n";
+            outcome.status = kBadInput;
         }
     } catch (const SceneError& e) {
         err << e.what() << "\n";
@@ -267,8 +344,14 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output, c
     } catch (const ImageError& e) {
         err << "drt: " << e.what() << "\n";
         outcome.status = kBadInput;
+    } catch (const LimitError& e) {
+        err << "drt: " << name << ": " << e.what() << "\n";
+        outcome.status = kBadInput;
+    } catch (const std::bad_alloc&) {
+        err << "drt: " << name << ": out of memory\n";
+        outcome.status = kFailed;
     } catch (const std::exception& e) {
-        err << "drt: " << scene_path << ": " << e.what() << "\n";
+        err << "drt: " << name << ": " << printable(e.what()) << "\n";
         outcome.status = kFailed;
     }
     return outcome;
@@ -281,8 +364,8 @@ void print_summary(const std::vector<SceneOutcome>& outcomes, std::ostream& out)
     for (const SceneOutcome& o : outcomes) {
         std::ostringstream size;
         if (o.width > 0) size << o.width << "x" << o.height;
-        out << std::left << std::setw(32) << fs::path(o.scene).filename().string() << std::right
-            << std::setw(11) << size.str() << std::setw(9)
+        out << std::left << std::setw(32) << printable(fs::path(o.scene).filename().string())
+            << std::right << std::setw(11) << size.str() << std::setw(9)
             << (o.samples ? std::to_string(o.samples) : "") << std::fixed << std::setprecision(2)
             << std::setw(10) << o.seconds << std::setw(10) << o.mrays_per_second
             << std::defaultfloat << "  "
@@ -294,7 +377,8 @@ void print_summary(const std::vector<SceneOutcome>& outcomes, std::ostream& out)
 }
 
 bool is_folder_target(const std::string& output) {
-    return !output.empty() && (output.back() == '/' || fs::is_directory(output));
+    std::error_code ignored;  // a name that cannot be examined is not a folder
+    return !output.empty() && (output.back() == '/' || fs::is_directory(output, ignored));
 }
 
 int render_command(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
@@ -313,7 +397,7 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
     job.overrides.add_to(app);
     job.adaptive.add_to(app);
     app.add_option("--threads", job.threads, "Worker threads (default: all cores)")
-        ->check(CLI::PositiveNumber);
+        ->check(integer_in(1, kMaxThreads));
     app.add_option("--stats", stats, "Write render statistics as JSON to FILE (- = stdout)");
     app.add_flag("-q,--quiet", job.quiet, "No progress display or messages besides errors");
     app.add_flag("--progress", force_progress, "Show progress even when stderr is not a terminal");
@@ -327,8 +411,17 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
         out << "drt " << DRT_VERSION << "\n";
         return kOk;
     } catch (const CLI::ParseError& e) {
-        err << "drt: " << e.what() << "\nRun 'drt --help' for usage.\n";
+        err << "drt: " << printable(e.what()) << "\nRun 'drt --help' for usage.\n";
         return kBadInput;
+    }
+    // Before any image replaces its output, so that a run never ends half done for want of it.
+    if (!stats.empty() && stats != "-") {
+        try {
+            check_replaceable(stats);
+        } catch (const FileWriteError& e) {
+            err << "drt: --stats " << e.what() << "\n";
+            return kBadInput;
+        }
     }
     job.progress = !job.quiet && (force_progress || isatty(STDERR_FILENO));
 
@@ -340,7 +433,8 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
             std::error_code ec;
             fs::create_directories(output, ec);
             if (ec) {
-                err << "drt: " << output << ": cannot create folder: " << ec.message() << "\n";
+                err << "drt: " << printable(output) << ": cannot create folder: " << ec.message()
+                    << "\n";
                 return kFailed;
             }
             target = fs::path(output) / target;
@@ -399,7 +493,7 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
         out << app.help();
         return kOk;
     } catch (const CLI::ParseError& e) {
-        err << "drt compare: " << e.what() << "\nRun 'drt compare --help' for usage.\n";
+        err << "drt compare: " << printable(e.what()) << "\nRun 'drt compare --help' for usage.\n";
         return kBadInput;
     }
     Comparison c;
@@ -409,8 +503,9 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
         const bool linear_a = format_for_path(a) == ImageFormat::kPfm;
         if (linear_a != (format_for_path(b) == ImageFormat::kPfm)) {
             // Linear floats against sRGB-encoded bytes would measure the tone curve, not the image.
-            throw ImageError("cannot compare " + (linear_a ? a : b) + " (linear .pfm) with " +
-                             (linear_a ? b : a) + " (8-bit sRGB): convert one first");
+            throw ImageError("cannot compare " + printable(linear_a ? a : b) +
+                             " (linear .pfm) with " + printable(linear_a ? b : a) +
+                             " (8-bit sRGB): convert one first");
         }
         if (!diff.empty()) format_for_path(diff);
         image_a = read_image(a);
@@ -419,6 +514,9 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
     } catch (const ImageError& e) {
         err << "drt compare: " << e.what() << "\n";
         return kBadInput;
+    } catch (const std::bad_alloc&) {
+        err << "drt compare: out of memory\n";
+        return kFailed;
     }
     out << std::setprecision(6) << "rmse=" << c.rmse << " psnr=" << c.psnr << " ssim=" << c.ssim
         << " max=" << c.max_abs << " nonfinite=" << c.nonfinite << "\n";
@@ -455,7 +553,7 @@ int info_command(int argc, const char* const* argv, std::ostream& out, std::ostr
         out << app.help();
         return kOk;
     } catch (const CLI::ParseError& e) {
-        err << "drt info: " << e.what() << "\nRun 'drt info --help' for usage.\n";
+        err << "drt info: " << printable(e.what()) << "\nRun 'drt info --help' for usage.\n";
         return kBadInput;
     }
     try {
@@ -465,6 +563,9 @@ int info_command(int argc, const char* const* argv, std::ostream& out, std::ostr
         out << describe(loaded.scene, plan_render(loaded.scene));
     } catch (const SceneError& e) {
         err << e.what() << "\n";
+        return kBadInput;
+    } catch (const LimitError& e) {
+        err << "drt info: " << printable(scene_path) << ": " << e.what() << "\n";
         return kBadInput;
     }
     return kOk;
@@ -487,14 +588,15 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
     app.add_option("--reference", reference_path,
                    "Reference image (.pfm) to measure against; default: render one");
     app.add_option("--reference-spp", reference_spp,
-                   "Samples of the rendered reference (default 16 x the largest count)")
-        ->check(CLI::PositiveNumber);
+                   "Samples of the rendered reference (default 16 x the largest count, at most " +
+                       std::to_string(kMaxSamples) + ")")
+        ->check(integer_in(1, kMaxSamples));
     app.add_option("--save-reference", save_reference, "Write the rendered reference to FILE.pfm");
     app.add_option("--csv", csv,
                    "Write spp,seconds,rmse,relmse,mean_spp,cpu_seconds,fitted rows to FILE");
     adaptive.add_to(app);
     app.add_option("--threads", threads, "Worker threads (default: all cores)")
-        ->check(CLI::PositiveNumber);
+        ->check(integer_in(1, kMaxThreads));
     std::vector<int> counts;
     try {
         app.parse(argc, argv);
@@ -509,10 +611,11 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
         out << app.help();
         return kOk;
     } catch (const CLI::ParseError& e) {
-        err << "drt converge: " << e.what() << "\nRun 'drt converge --help' for usage.\n";
+        err << "drt converge: " << printable(e.what())
+            << "\nRun 'drt converge --help' for usage.\n";
         return kBadInput;
     } catch (const std::exception& e) {  // a bad count list or image name
-        err << "drt converge: " << e.what() << "\n";
+        err << "drt converge: " << printable(e.what()) << "\n";
         return kBadInput;
     }
     try {
@@ -521,6 +624,15 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
         Scene& scene = loaded.scene;
         overrides.apply(scene.settings);
         const RenderSettings& s = scene.settings;
+        {
+            // Checked with the most samples any render here will take.
+            RenderSettings largest = s;
+            largest.samples = std::max(*std::max_element(counts.begin(), counts.end()),
+                                       reference_spp.value_or(default_reference_spp(counts)));
+            if (const auto problem = render_limit_problem(largest, threads)) {
+                throw LimitError(*problem);
+            }
+        }
         RenderOptions options;
         options.threads = threads;
         options.adaptive = adaptive.settings();
@@ -589,8 +701,14 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
     } catch (const ImageError& e) {
         err << "drt converge: " << e.what() << "\n";
         return kBadInput;
+    } catch (const LimitError& e) {
+        err << "drt converge: " << printable(scene_path) << ": " << e.what() << "\n";
+        return kBadInput;
+    } catch (const std::bad_alloc&) {
+        err << "drt converge: " << printable(scene_path) << ": out of memory\n";
+        return kFailed;
     } catch (const std::exception& e) {
-        err << "drt converge: " << scene_path << ": " << e.what() << "\n";
+        err << "drt converge: " << printable(scene_path) << ": " << printable(e.what()) << "\n";
         return kFailed;
     }
     return kOk;
@@ -599,14 +717,22 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
 }  // namespace
 
 int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
-    if (argc >= 2) {
-        const std::string command = argv[1];
-        // CLI11 takes the program name from argv[0]; hand it "drt compare" and the rest.
-        if (command == "compare") return compare_command(argc - 1, argv + 1, out, err);
-        if (command == "info") return info_command(argc - 1, argv + 1, out, err);
-        if (command == "converge") return converge_command(argc - 1, argv + 1, out, err);
+    // The last guard: every command catches what it expects, and nothing may end in an abort.
+    try {
+        if (argc >= 2) {
+            const std::string command = argv[1];
+            // CLI11 takes the program name from argv[0]; hand it "drt compare" and the rest.
+            if (command == "compare") return compare_command(argc - 1, argv + 1, out, err);
+            if (command == "info") return info_command(argc - 1, argv + 1, out, err);
+            if (command == "converge") return converge_command(argc - 1, argv + 1, out, err);
+        }
+        return render_command(argc, argv, out, err);
+    } catch (const std::bad_alloc&) {
+        err << "drt: out of memory\n";
+    } catch (const std::exception& e) {
+        err << "drt: " << printable(e.what()) << "\n";
     }
-    return render_command(argc, argv, out, err);
+    return kFailed;
 }
 
 }  // namespace drt

@@ -106,7 +106,7 @@ double srgb_to_linear(double v) {
 Color false_colour(double t) {
     static constexpr std::array<Color, 5> kStops{
         {{0, 0, 0}, {0, 0, 1}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}}};
-    const double s = std::clamp(t, 0.0, 1.0) * (kStops.size() - 1);
+    const double s = (t > 0 ? std::min(t, 1.0) : 0.0) * (kStops.size() - 1);  // NaN as 0
     const std::size_t k = std::min(static_cast<std::size_t>(s), kStops.size() - 2);
     const Color c = lerp(kStops[k], kStops[k + 1], s - k);
     return {srgb_to_linear(c.r), srgb_to_linear(c.g), srgb_to_linear(c.b)};

@@ -9,6 +9,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "drt/limits.h"
+#include "drt/text.h"
+
 namespace drt {
 
 namespace {
@@ -71,7 +74,8 @@ double loglog_slope(const std::vector<double>& x, const std::vector<double>& y) 
 
 int default_reference_spp(const std::vector<int>& spps) {
     const int largest = spps.empty() ? 1 : *std::max_element(spps.begin(), spps.end());
-    return 16 * largest;
+    // In 64 bits, then capped: 16 x a count near 2^31 would overflow an int.
+    return static_cast<int>(std::min<std::int64_t>(16 * std::int64_t{largest}, kMaxSamples));
 }
 
 std::uint64_t reference_seed(std::uint64_t seed) {
@@ -137,9 +141,11 @@ std::vector<int> parse_counts(const std::string& list) {
         const std::string item = list.substr(start, end - start);
         int value = 0;
         const auto [ptr, ec] = std::from_chars(item.data(), item.data() + item.size(), value);
-        if (item.empty() || ec != std::errc() || ptr != item.data() + item.size() || value <= 0) {
-            throw std::invalid_argument("'" + item + "' in '" + list +
-                                        "' is not a positive sample count");
+        if (item.empty() || ec != std::errc() || ptr != item.data() + item.size() || value <= 0 ||
+            value > kMaxSamples) {
+            throw std::invalid_argument("'" + abbreviated(item) + "' in '" + abbreviated(list) +
+                                        "' is not a sample count from 1 to " +
+                                        std::to_string(kMaxSamples));
         }
         counts.push_back(value);
         if (end == list.size()) break;

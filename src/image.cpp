@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <stb_image.h>
 #include <stb_image_write.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,13 +14,14 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <memory>
-#include <random>
 #include <string>
 #include <string_view>
 #include <system_error>
+
+#include "drt/atomic_file.h"
+#include "drt/limits.h"
+#include "drt/text.h"
 
 namespace drt {
 
@@ -33,7 +35,12 @@ using Bytes = std::vector<unsigned char>;
 constexpr int kMaxSide = 1 << 24;
 
 [[noreturn]] void fail(const fs::path& path, const std::string& what) {
-    throw ImageError(path.string() + ": " + what);
+    throw ImageError(printable(path.string()) + ": " + what);
+}
+
+std::string too_many_pixels(int w, int h) {
+    return "image of " + std::to_string(w) + "x" + std::to_string(h) +
+           " pixels exceeds the limit of " + std::to_string(kMaxPixels) + " pixels";
 }
 
 std::string errno_text(int err) {
@@ -85,81 +92,50 @@ Bytes encode_pfm(const Image& image) {
     return file;
 }
 
-// ---- atomic file replacement ----------------------------------------------------------------
-
-// Closes the descriptor and removes the temporary file unless the write was committed, so
-// every failure path leaves the folder as it was.
-class TempFile {
-  public:
-    explicit TempFile(const fs::path& target) {
-        const fs::path dir = target.parent_path();
-        std::random_device seed;
-        std::mt19937_64 rng((std::uint64_t{seed()} << 32) ^ seed());
-        // O_EXCL makes the name ours alone; retry in the unlikely event of a clash.
-        int err = 0;
-        for (int attempt = 0; attempt < 16; ++attempt) {
-            std::string name = ".";
-            name += target.filename().string();
-            name += ".tmp-";
-            name += std::to_string(getpid());
-            name += '-';
-            name += std::to_string(rng());
-            path_ = dir / name;
-            fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-            err = errno;
-            if (fd_ >= 0 || err != EEXIST) break;
-        }
-        if (fd_ < 0) fail(target, "cannot create file: " + errno_text(err));
-    }
-    TempFile(const TempFile&) = delete;
-    TempFile& operator=(const TempFile&) = delete;
-    ~TempFile() {
-        if (fd_ >= 0) ::close(fd_);
-        if (!committed_) ::unlink(path_.c_str());
-    }
-
-    // Returns 0 or the errno of the first failure.
-    int write_all(const Bytes& data) {
-        std::size_t done = 0;
-        while (done < data.size()) {
-            const ssize_t n = ::write(fd_, data.data() + done, data.size() - done);
-            if (n < 0 && errno == EINTR) continue;
-            if (n <= 0) return n < 0 ? errno : EIO;
-            done += static_cast<std::size_t>(n);
-        }
-        // fsync before the rename, or a crash could leave the new name on an empty file.
-        if (::fsync(fd_) != 0) return errno;
-        const int fd = fd_;
-        fd_ = -1;
-        return ::close(fd) != 0 ? errno : 0;
-    }
-
-    void commit_as(const fs::path& target) {
-        std::error_code ec;
-        fs::rename(path_, target, ec);
-        if (ec) fail(target, "cannot write file: " + ec.message());
-        committed_ = true;
-    }
-
-  private:
-    fs::path path_;
-    int fd_ = -1;
-    bool committed_ = false;
-};
-
-void replace_file(const fs::path& path, const Bytes& data) {
-    TempFile tmp(path);
-    if (const int err = tmp.write_all(data)) fail(path, "cannot write file: " + errno_text(err));
-    tmp.commit_as(path);
-}
-
 // ---- decoding -------------------------------------------------------------------------------
 
+// Reads a whole regular file of at most kMaxImageFileBytes: a device, a pipe or a folder named
+// like an image is refused before reading, and a file that grows while read is cut off.
 Bytes read_file(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) fail(path, "cannot open file: " + errno_text(errno));
-    Bytes data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) fail(path, "cannot read file");
+    struct Descriptor {
+        int fd;
+        ~Descriptor() {
+            if (fd >= 0) ::close(fd);
+        }
+    } const file{::open(path.c_str(), O_RDONLY | O_CLOEXEC)};
+    const int fd = file.fd;
+    if (fd < 0) fail(path, "cannot open file: " + errno_text(errno));
+    struct stat info {};
+    if (::fstat(fd, &info) != 0) fail(path, "cannot open file: " + errno_text(errno));
+    if (!S_ISREG(info.st_mode)) {
+        fail(path, S_ISDIR(info.st_mode) ? "is a folder, not an image file" : "not a regular file");
+    }
+    const auto too_large = [&] {
+        fail(path, "file larger than the " + std::to_string(kMaxImageFileBytes >> 20) +
+                       " MiB limit for an image");
+    };
+    if (static_cast<std::uint64_t>(info.st_size) > kMaxImageFileBytes) too_large();
+    Bytes data(static_cast<std::size_t>(info.st_size));
+    std::size_t done = 0;
+    for (;;) {
+        if (done == data.size()) {
+            if (data.size() >= kMaxImageFileBytes) {
+                // At the limit: one more byte means too large.
+                unsigned char extra = 0;
+                const ssize_t n = ::read(fd, &extra, 1);
+                if (n < 0 && errno == EINTR) continue;
+                if (n > 0) too_large();
+                break;
+            }
+            data.resize(std::min<std::uint64_t>(kMaxImageFileBytes, 2 * data.size() + 65536));
+        }
+        const ssize_t n = ::read(fd, data.data() + done, data.size() - done);
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) fail(path, "cannot read file: " + errno_text(errno));
+        if (n == 0) break;
+        done += static_cast<std::size_t>(n);
+    }
+    data.resize(done);
     return data;
 }
 
@@ -194,6 +170,11 @@ Image decode_8bit(const Bytes& data, ImageFormat format, const fs::path& path) {
     if (!is_png && bmp_is_truncated(data)) fail(path, "truncated BMP file");
     if (data.size() > static_cast<std::size_t>(INT32_MAX)) fail(path, "file too large");
     int w = 0, h = 0, channels = 0;
+    // The size from the header, before stb allocates for it.
+    if (stbi_info_from_memory(data.data(), static_cast<int>(data.size()), &w, &h, &channels) &&
+        std::uint64_t(w) * std::uint64_t(h) > kMaxPixels) {
+        fail(path, too_many_pixels(w, h));
+    }
     const std::unique_ptr<stbi_uc, decltype(&stbi_image_free)> pixels(
         stbi_load_from_memory(data.data(), static_cast<int>(data.size()), &w, &h, &channels, 3),
         &stbi_image_free);
@@ -255,6 +236,7 @@ Image decode_pfm(const Bytes& data, const fs::path& path) {
     const int h = header.number<int>("height");
     const double scale = header.number<double>("scale");
     if (w <= 0 || h <= 0 || w > kMaxSide || h > kMaxSide) fail(path, "bad PFM size");
+    if (std::uint64_t(w) * std::uint64_t(h) > kMaxPixels) fail(path, too_many_pixels(w, h));
     if (scale == 0 || !std::isfinite(scale)) fail(path, "bad PFM scale");
     const std::size_t start = header.data_start();
 
@@ -305,8 +287,13 @@ void write_image(const Image& image, const fs::path& path) {
     if (image.rgb.size() != 3 * static_cast<std::size_t>(image.width) * image.height) {
         fail(path, "image data does not match its size");
     }
-    replace_file(
-        path, format == ImageFormat::kPfm ? encode_pfm(image) : encode_8bit(image, format, path));
+    const Bytes file =
+        format == ImageFormat::kPfm ? encode_pfm(image) : encode_8bit(image, format, path);
+    try {
+        replace_file(path, file);
+    } catch (const FileWriteError& e) {
+        throw ImageError(e.what());
+    }
 }
 
 Image read_image(const fs::path& path) {

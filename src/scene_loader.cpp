@@ -25,9 +25,11 @@
 #include <type_traits>
 #include <vector>
 
+#include "drt/limits.h"
 #include "drt/plane.h"
 #include "drt/sampler.h"
 #include "drt/sphere.h"
+#include "drt/text.h"
 #include "drt/texture.h"
 
 namespace drt {
@@ -128,12 +130,12 @@ class Context {
     }
     [[noreturn]] void fail_at(int line, std::string_view element,
                               const std::string& message) const {
-        throw SceneError(file_ + ":" + std::to_string(std::max(line, 1)) + ": " +
-                         std::string(element) + ": " + message);
+        throw SceneError(printable(file_ + ":" + std::to_string(std::max(line, 1)) + ": " +
+                                   std::string(element) + ": " + message));
     }
     void warn(const XMLElement& element, const std::string& message) {
-        warnings_.push_back(file_ + ":" + std::to_string(element.GetLineNum()) +
-                            ": warning: " + message);
+        warnings_.push_back(printable(file_ + ":" + std::to_string(element.GetLineNum()) +
+                                      ": warning: " + message));
     }
     void warn_unknown_element(const XMLElement& element, const XMLElement& parent,
                               std::span<const std::string_view> allowed) {
@@ -217,7 +219,7 @@ class Attributes {
         if (!value) return fallback;
         const std::string_view t = trim(*value);
         if (t != "0" && t != "1") {
-            fail(std::string(name) + " must be 0 or 1, got \"" + std::string(*value) + "\"");
+            fail(std::string(name) + " must be 0 or 1, got \"" + abbreviated(*value) + "\"");
         }
         return t == "1";
     }
@@ -229,7 +231,7 @@ class Attributes {
     // The attribute's value as the user wrote it, for messages.
     std::string shown(std::string_view name) const {
         const char* value = element_.Attribute(std::string(name).c_str());
-        return value ? std::string(trim(value)) : "(default)";
+        return value ? abbreviated(trim(value)) : "(default)";
     }
 
     // Call once the element has been read completely.
@@ -265,7 +267,7 @@ class Attributes {
         const std::string problem = ec == std::errc::result_out_of_range
                                         ? "is out of range"
                                         : "is not " + std::string(kind);
-        fail("attribute " + quoted(name) + " " + problem + ": \"" + std::string(value) + "\"");
+        fail("attribute " + quoted(name) + " " + problem + ": \"" + abbreviated(value) + "\"");
     }
 
     const XMLElement& element_;
@@ -301,7 +303,8 @@ SurfaceSpec read_surface(Attributes& in) {
     s.k2 = in.color("k2r", "k2g", "k2b", {0.1, 0.1, 0.1});
     // Checked even when disabled, so that a misspelt name does not wait to be found until the
     // texture is switched on.
-    if (!make_texture(s.texture, {}, {}, 1)) in.fail("unknown texture '" + s.texture + "'");
+    if (!make_texture(s.texture, {}, {}, 1))
+        in.fail("unknown texture '" + abbreviated(s.texture) + "'");
 
     const bool bumped = in.flag("bumpEnable", false);
     BumpMap bump;
@@ -310,6 +313,11 @@ SurfaceSpec read_surface(Attributes& in) {
     bump.strength = in.number("BumpStrength", bump.strength);
     if (bumped) s.bump = bump;
     return s;
+}
+
+// The rule of a limit from limits.h, for Attributes::check: "Width must be at most 65536, got ...".
+std::string at_most(int limit) {
+    return "at most " + std::to_string(limit);
 }
 
 // Scales a vector so its largest component is ±1: normalising that is safe for any finite
@@ -482,8 +490,15 @@ class SceneReader {
         RenderSettings& s = scene_.settings;
         s.width = in.integer("Width", s.width);
         in.check(s.width > 0, "Width", "positive");
+        in.check(s.width <= kMaxImageSide, "Width", at_most(kMaxImageSide));
         s.height = in.integer("Height", s.height);
         in.check(s.height > 0, "Height", "positive");
+        in.check(s.height <= kMaxImageSide, "Height", at_most(kMaxImageSide));
+        if (std::uint64_t(s.width) * std::uint64_t(s.height) > kMaxPixels) {
+            in.fail("image of " + std::to_string(s.width) + "x" + std::to_string(s.height) +
+                    " pixels exceeds the limit of " + std::to_string(kMaxPixels) +
+                    " pixels (docs/scene-format.md#limits)");
+        }
         in.warn_unknown();
         warn_children(e);
     }
@@ -493,16 +508,20 @@ class SceneReader {
         RenderSettings& s = scene_.settings;
         s.samples = in.integer("Samples", s.samples);
         in.check(s.samples > 0, "Samples", "positive");
+        in.check(s.samples <= kMaxSamples, "Samples", at_most(kMaxSamples));
         s.shadow_rays = in.integer("ShadowRays", s.shadow_rays);
         in.check(s.shadow_rays > 0, "ShadowRays", "positive");
+        in.check(s.shadow_rays <= kMaxRaysPerPoint, "ShadowRays", at_most(kMaxRaysPerPoint));
         s.max_depth = in.integer("MaxDepth", s.max_depth);
         in.check(s.max_depth >= 0, "MaxDepth", "non-negative");
+        in.check(s.max_depth <= kMaxDepthLimit, "MaxDepth", at_most(kMaxDepthLimit));
         s.glossy_rays = in.integer("GlossyRays", s.glossy_rays);
         in.check(s.glossy_rays > 0, "GlossyRays", "positive");
+        in.check(s.glossy_rays <= kMaxRaysPerPoint, "GlossyRays", at_most(kMaxRaysPerPoint));
         s.seed = in.integer("Seed", s.seed);
         s.sampler = in.text("Sampler", s.sampler);
         if (!make_sampler(s.sampler))
-            in.fail("unknown sampler '" + s.sampler + "'; known: " + sampler_list());
+            in.fail("unknown sampler '" + abbreviated(s.sampler) + "'; known: " + sampler_list());
         in.warn_unknown();
         warn_children(e);
     }
@@ -587,7 +606,7 @@ class SceneReader {
 
         const auto [it, first] = material_lines_.try_emplace(m->name, e.GetLineNum());
         if (!first) {
-            in.fail("duplicate material '" + m->name + "' (first defined on line " +
+            in.fail("duplicate material '" + abbreviated(m->name) + "' (first defined on line " +
                     std::to_string(it->second) + ")");
         }
         scene_.materials.push_back(std::move(m));
@@ -678,7 +697,7 @@ class SceneReader {
     std::string unknown_material(const std::string& name) const {
         std::vector<std::string_view> names;
         for (const auto& m : scene_.materials) names.push_back(m->name);
-        std::string message = "unknown material '" + name + "'";
+        std::string message = "unknown material '" + abbreviated(name) + "'";
         if (const auto guess = nearest(name, names))
             message += "; did you mean '" + std::string(*guess) + "'?";
         return message;
@@ -693,7 +712,7 @@ class SceneReader {
 
 std::string read_file(const std::filesystem::path& path) {
     const auto cannot_open = [&](int error) {
-        return SceneError(path.string() + ": cannot open scene: " +
+        return SceneError(printable(path.string()) + ": cannot open scene: " +
                           std::error_code(error, std::generic_category()).message());
     };
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
@@ -702,7 +721,14 @@ std::string read_file(const std::filesystem::path& path) {
     std::string contents;
     char buffer[1 << 16];
     std::size_t n = 0;
-    while ((n = std::fread(buffer, 1, sizeof buffer, file.get())) > 0) contents.append(buffer, n);
+    while ((n = std::fread(buffer, 1, sizeof buffer, file.get())) > 0) {
+        // Checked while reading, so that an endless input (/dev/zero) stops too.
+        if (contents.size() + n > kMaxSceneBytes) {
+            throw SceneError(printable(path.string()) + ": scene file larger than the " +
+                             std::to_string(kMaxSceneBytes >> 20) + " MiB limit");
+        }
+        contents.append(buffer, n);
+    }
     // A directory opens fine on Linux and fails only when read (EISDIR).
     if (std::ferror(file.get())) throw cannot_open(errno);
     return contents;

@@ -59,13 +59,21 @@ constexpr double mix(double a, double b, double t) {
     return a + t * (b - a);
 }
 
+// floor(v) as an integer modulo 2^62 (v already whole), 0 for NaN: every double of magnitude 2^62
+// or more is a multiple of 2^10, so its low bits, all that the lattice hash and the checker parity
+// read, are exactly 0. A plain conversion would be undefined behaviour there (a tiny scale).
+long long lattice(double whole) {
+    constexpr double kBound = 0x1p62;
+    return whole > -kBound && whole < kBound ? static_cast<long long>(whole) : 0;
+}
+
 }  // namespace
 
 double perlin_noise(const Vec3& p) {
     const double fx = std::floor(p.x), fy = std::floor(p.y), fz = std::floor(p.z);
-    const int X = static_cast<int>(static_cast<long long>(fx) & 255);
-    const int Y = static_cast<int>(static_cast<long long>(fy) & 255);
-    const int Z = static_cast<int>(static_cast<long long>(fz) & 255);
+    const int X = static_cast<int>(lattice(fx) & 255);
+    const int Y = static_cast<int>(lattice(fy) & 255);
+    const int Z = static_cast<int>(lattice(fz) & 255);
     const double x = p.x - fx, y = p.y - fy, z = p.z - fz;
     const double u = fade(x), v = fade(y), w = fade(z);
     auto g = [&](int dx, int dy, int dz) {
@@ -85,8 +93,9 @@ double turbulence(const Vec3& p, int octaves) {
 }
 
 Color CheckerTexture::value(const Vec3& local) const {
-    const auto cell = [&](double c) { return static_cast<long long>(std::floor(c / scale_)); };
-    const long long parity = cell(local.x) + cell(local.y) + cell(local.z);
+    const auto cell = [&](double c) { return lattice(std::floor(c / scale_)); };
+    // The parity of the sum from the parities: the sum itself could overflow.
+    const long long parity = cell(local.x) ^ cell(local.y) ^ cell(local.z);
     return (parity & 1) == 0 ? a_ : b_;
 }
 

@@ -71,19 +71,24 @@ TEST(Converge, LogLogSlopeOfAPowerLaw) {
 TEST(Converge, ParsesCountLists) {
     EXPECT_EQ(parse_counts("1,4,16"), (std::vector<int>{1, 4, 16}));
     EXPECT_EQ(parse_counts("7"), (std::vector<int>{7}));
-    for (const char* bad : {"", "1,,4", "1,4,", "0", "-1", "1.5", "4x", "99999999999"}) {
+    EXPECT_EQ(parse_counts("1,65536"), (std::vector<int>{1, 65536}));  // kMaxSamples
+    for (const char* bad : {"", "1,,4", "1,4,", "0", "-1", "1.5", "4x", "99999999999", "65537"}) {
         EXPECT_THROW(parse_counts(bad), std::invalid_argument) << bad;
     }
     try {
         parse_counts("1,x,4");
         FAIL();
     } catch (const std::invalid_argument& e) {
-        EXPECT_STREQ(e.what(), "'x' in '1,x,4' is not a positive sample count");
+        EXPECT_STREQ(e.what(), "'x' in '1,x,4' is not a sample count from 1 to 65536");
     }
 }
 
 TEST(Converge, DefaultReferenceIsSixteenTimesTheLargestCountWithAnotherSeed) {
     EXPECT_EQ(default_reference_spp({1, 4, 256, 16}), 4096);
+    // Capped at kMaxSamples, computed without overflow (16 x 2^31 - 1 wrapped before).
+    EXPECT_EQ(default_reference_spp({4096}), 65536);
+    EXPECT_EQ(default_reference_spp({4097}), 65536);
+    EXPECT_EQ(default_reference_spp({2147483647}), 65536);
     EXPECT_EQ(reference_seed(0), 1u);
     EXPECT_EQ(reference_seed(41), 42u);
 }
@@ -203,7 +208,7 @@ TEST(ConvergeCli, RefusesBadInput) {
     const std::string scene = std::string(DRT_SOURCE_DIR) + "/scenes/figures/aa-10spp.xml";
     CliRun r = run({"converge", scene, "--spp", "1,0,4"});
     EXPECT_EQ(r.status, 2);
-    EXPECT_NE(r.err.find("'0' in '1,0,4' is not a positive sample count"), std::string::npos)
+    EXPECT_NE(r.err.find("'0' in '1,0,4' is not a sample count from 1 to 65536"), std::string::npos)
         << r.err;
     r = run({"converge", scene, "--reference", "ref.png"});
     EXPECT_EQ(r.status, 2);

@@ -48,7 +48,8 @@ double relative_mse(const Image& image, const Image& reference);
 // fewer than two such pairs have distinct x.
 double loglog_slope(const std::vector<double>& x, const std::vector<double>& y);
 
-// The reference drt converge renders when given none: 16 times the largest count, with seed + 1
+// The reference drt converge renders when given none: 16 times the largest count (at most
+// kMaxSamples, limits.h), with seed + 1
 // so that its noise is independent of every image it judges.
 int default_reference_spp(const std::vector<int>& spps);
 std::uint64_t reference_seed(std::uint64_t seed);
@@ -65,7 +66,7 @@ Convergence measure_convergence(Scene& scene, const std::vector<int>& spps, cons
 // "spp,seconds,rmse,relmse,mean_spp,cpu_seconds,fitted" and one line per point.
 std::string convergence_csv(const Convergence& c);
 
-// Parses a comma-separated list of positive counts such as "1,4,16"; throws
+// Parses a comma-separated list of counts from 1 to kMaxSamples such as "1,4,16"; throws
 // std::invalid_argument naming the offending item.
 std::vector<int> parse_counts(const std::string& list);
 
