@@ -1,0 +1,95 @@
+// A triangle mesh as drt stores and intersects it: vertex positions in single precision relative
+// to the mesh's own origin (the centre of its bounds), one index buffer, vertex normals for
+// smooth shading, and a bounding-volume hierarchy of its own over its triangles. A scene places
+// the mesh by translating that origin (and moves it by moving the translation), so a mesh keeps
+// its single-precision detail however far from the world's origin it stands.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "drt/math.h"
+#include "drt/obj_reader.h"
+#include "drt/ray.h"
+#include "drt/triangle.h"
+
+namespace drt {
+
+// How a file's vertices are turned: scaled by `scale` (positive), then rotated about x, y and z
+// in that order by `rotate_degrees` (right-handed rotations of the vertex), before the scene
+// translates them.
+struct MeshTransform {
+    double scale = 1;
+    Vec3 rotate_degrees;
+
+    Vec3 apply(const Vec3& v) const;
+    // The same rotation for a direction (a uniform positive scale leaves directions alone).
+    Vec3 rotate(const Vec3& v) const;
+};
+
+struct MeshHit {
+    double t;
+    std::uint32_t triangle;
+    Barycentrics b;
+};
+
+class TriangleMesh {
+  public:
+    // Transforms the file's vertices and builds the hierarchy. Triangles of zero area are left
+    // out (dropped() counts them). With `smooth`, vertex normals are the file's `vn` where a
+    // corner has one, else the angle-weighted normals of the faces around the vertex. Throws
+    // std::domain_error if a transformed coordinate does not fit in single precision.
+    TriangleMesh(const ObjMesh& obj, const MeshTransform& transform, bool smooth);
+
+    std::size_t triangle_count() const { return triangles_.size(); }
+    std::size_t dropped() const { return dropped_; }
+    // Where the mesh's own coordinates have their origin, in the coordinates of the transform.
+    const Vec3& origin() const { return origin_; }
+    // Bounds in the mesh's own coordinates.
+    Bounds bounds() const;
+
+    // Nearest hit inside `range` of a ray given in the mesh's own coordinates.
+    std::optional<MeshHit> intersect(const Ray& ray, Interval range) const;
+    // Whether any triangle meets the ray inside `range` (stops at the first).
+    bool occluded(const Ray& ray, Interval range) const;
+
+    std::array<Vec3, 3> corners(std::uint32_t triangle) const;
+    // Unit (p1 - p0) × (p2 - p0): outward for a closed mesh wound counter-clockwise.
+    Vec3 geometric_normal(std::uint32_t triangle) const;
+    // Unit interpolated vertex normal, or the geometric normal for a flat mesh; may face either
+    // way relative to the geometric normal.
+    Vec3 shading_normal(std::uint32_t triangle, const Barycentrics& b) const;
+    bool smooth() const { return !normals_.empty(); }
+
+    // Memory held for geometry and hierarchy.
+    std::size_t bytes() const;
+
+  private:
+    using Float3 = std::array<float, 3>;
+    // One node is 32 bytes: its box, and either its triangles (a leaf: `count` of them from
+    // `offset`) or its second child (an inner node: `count` 0, the first child follows it).
+    struct Node {
+        Float3 lo, hi;
+        std::uint32_t offset;
+        std::uint32_t count;
+    };
+    struct BuildItem;
+
+    Vec3 position(std::uint32_t vertex) const;
+    void build_hierarchy();
+    std::uint32_t build(std::vector<BuildItem>& items, std::uint32_t begin, std::uint32_t end,
+                        int depth);
+    template <bool kAnyHit>
+    std::optional<MeshHit> traverse(const Ray& ray, Interval range) const;
+
+    Vec3 origin_;
+    std::vector<Float3> positions_;  // relative to origin_
+    std::vector<Float3> normals_;    // per vertex, unit; empty for a flat mesh
+    std::vector<std::array<std::uint32_t, 3>> triangles_;  // in leaf order
+    std::vector<Node> nodes_;
+    std::size_t dropped_ = 0;
+};
+
+}  // namespace drt
