@@ -11,6 +11,8 @@
 #include <memory>
 #include <system_error>
 
+#include "drt/text.h"
+
 namespace drt {
 
 namespace {
@@ -79,7 +81,7 @@ class ObjParser {
         } else if (keyword == "vn") {
             mesh_.normals.push_back(point(tokens, "vn"));
             if (const std::string_view extra = tokens.next(); !extra.empty())
-                fail("vn: more than 3 coordinates: \"" + std::string(extra) + "\"");
+                fail("vn: more than 3 coordinates: \"" + abbreviated(extra) + "\"");
         } else if (keyword == "vt") {
             // Unused, but counted, so that a face's texture index can be checked.
             ++texture_count_;
@@ -108,11 +110,11 @@ class ObjParser {
         const char* end = digits.data() + digits.size();
         const auto [ptr, ec] = std::from_chars(digits.data(), end, x);
         if (ec == std::errc::invalid_argument || ptr != end)
-            fail(std::string(keyword) + ": \"" + std::string(token) + "\" is not a number");
+            fail(std::string(keyword) + ": \"" + abbreviated(token) + "\" is not a number");
         if (ec == std::errc::result_out_of_range)
-            fail(std::string(keyword) + ": \"" + std::string(token) + "\" is out of range");
+            fail(std::string(keyword) + ": \"" + abbreviated(token) + "\" is out of range");
         if (!std::isfinite(x))
-            fail(std::string(keyword) + ": \"" + std::string(token) + "\" is not a finite number");
+            fail(std::string(keyword) + ": \"" + abbreviated(token) + "\" is not a finite number");
         return x;
     }
 
@@ -154,22 +156,22 @@ class ObjParser {
         const char* end = digits.data() + digits.size();
         const auto [ptr, ec] = std::from_chars(digits.data(), end, i);
         if (digits.empty() || ec == std::errc::invalid_argument || ptr != end)
-            fail("f: \"" + std::string(token) + "\" is not a vertex reference");
+            fail("f: \"" + abbreviated(token) + "\" is not a vertex reference");
         const auto n = static_cast<long long>(count);
         const bool beyond = ec == std::errc::result_out_of_range || i > n || i < -n;
         if (!beyond && i == 0) {
-            fail("f: " + std::string(kind) + " index 0 in \"" + std::string(token) +
+            fail("f: " + std::string(kind) + " index 0 in \"" + abbreviated(token) +
                  "\"; indices start at 1");
         }
         if (beyond) {
-            fail("f: " + std::string(kind) + " index " + std::string(digits) +
+            fail("f: " + std::string(kind) + " index " + abbreviated(digits) +
                  " is out of range; " + std::to_string(count) + " defined above");
         }
         return static_cast<std::uint32_t>(i > 0 ? i - 1 : n + i);
     }
 
     [[noreturn]] void fail(const std::string& message) const {
-        throw ObjError(name_ + ":" + std::to_string(line_) + ": " + message);
+        throw ObjError(printable(name_ + ":" + std::to_string(line_) + ": " + message));
     }
 
     std::string_view text_;

@@ -86,6 +86,10 @@ TEST(ObjReader, RejectsCoordinatesThatAreNotFiniteNumbers) {
     EXPECT_EQ(error_of("vn 0 0 NaN\n"), "m.obj:1: vn: \"NaN\" is not a finite number");
     EXPECT_EQ(error_of("v 0 0 0 red\n"), "m.obj:1: v: \"red\" is not a number");
     EXPECT_EQ(error_of("v 0 1\n"), "m.obj:1: v: 3 coordinates needed, got 2");
+    // What the file holds is shown safely: control characters escaped, a long value cut.
+    EXPECT_EQ(error_of("v 0 \x1b[2J 0\n"), "m.obj:1: v: \"\\x1b[2J\" is not a number");
+    EXPECT_EQ(error_of("v 0 " + std::string(400, '7') + "x 0\n"),
+              "m.obj:1: v: \"77777777777777777777... (401 characters)\" is not a number");
     EXPECT_EQ(error_of("vn 0 1 0 1\n"), "m.obj:1: vn: more than 3 coordinates: \"1\"");
 }
 
