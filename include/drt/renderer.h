@@ -1,35 +1,32 @@
-// Renders a scene into an image: tiles handed out to worker threads, each pixel a pure function
-// of the scene, the options and the seed, so the image never depends on the thread count.
+// Renders a scene into an image: tiles from a TileSource rendered by worker threads
+// (RenderContext::render_tile) and handed to a TileSink. Each pixel is a pure function of the
+// scene, the options and the seed, so the image never depends on the thread count, the order of
+// the tiles or which process rendered them.
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <stop_token>
 #include <vector>
 
 #include "drt/image.h"
 #include "drt/integrator.h"
+#include "drt/render_context.h"
 #include "drt/render_plan.h"
 #include "drt/scene.h"
+#include "drt/tile.h"
 
 namespace drt {
-
-// Adaptive sampling: each pixel takes samples in rounds, each round as many as it has so far,
-// and stops once the estimated standard error of its mean luminance falls below the threshold,
-// or at the scene's sample count. The estimate is the sample deviation over sqrt(n), or for a
-// progressive sampler the spread of the means of 8 consecutive runs over sqrt(8), which credits
-// stratification. The decision reads only the pixel's own samples, so the image stays
-// independent of the thread count.
-struct AdaptiveSampling {
-    double noise_threshold = 0;  // in linear luminance units
-    int min_samples = 16;        // taken before the estimate is trusted; capped at the maximum
-};
 
 struct RenderOptions {
     int threads = 0;  // 0 = all cores
     // Called now and then from the rendering thread with the fraction done (0..1).
     std::function<void(double)> on_progress;
     std::optional<AdaptiveSampling> adaptive;  // absent: every pixel takes the scene's samples
+    // Checked between tiles: once a stop is requested, each worker finishes the tile in hand and
+    // takes no other, so only whole tiles are done (RenderResult::unfinished lists the rest).
+    std::stop_token stop;
 };
 
 struct RenderStats {
@@ -48,8 +45,23 @@ struct RenderResult {
     RenderStats stats;
     // Adaptive sampling only: the camera samples each pixel took, row by row.
     std::vector<std::uint32_t> pixel_samples;
+    // Tiles not rendered because a stop was requested (their pixels are 0); empty otherwise.
+    std::vector<Tile> unfinished;
 };
 
+// The whole image.
 RenderResult render(const Scene& scene, const RenderOptions& options);
+
+// The tiles `sink` does not have yet, then the result of all of them: a render resumed from
+// tiles finished earlier (added to the sink first) gives the same bits as one never stopped.
+// options.adaptive is ignored: the context's applies.
+RenderResult render(const RenderContext& context, ImageSink& sink, const RenderOptions& options);
+
+// Renders tiles from `source` on options.threads workers (capped at source.size()) into `sink`
+// until the source runs dry or a stop is requested. An exception in a worker (from the source,
+// the tile or the sink) stops the other workers after their tile in hand and is rethrown here.
+// options.on_progress gets the fraction of source.size() done. Returns the threads used.
+int render_tiles(const RenderContext& context, TileSource& source, TileSink& sink,
+                 const RenderOptions& options);
 
 }  // namespace drt

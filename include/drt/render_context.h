@@ -1,0 +1,78 @@
+// What a render builds once from the scene — the sampler, the plan, the acceleration structure,
+// the integrator and the tile grid — and the one function that turns a tile into its buffer.
+// A tile's buffer depends on nothing but the scene, the adaptive settings and the tile, so any
+// process holding the same scene renders the same bits for it.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "drt/bvh.h"
+#include "drt/integrator.h"
+#include "drt/render_plan.h"
+#include "drt/sampler.h"
+#include "drt/scene.h"
+#include "drt/tile.h"
+
+namespace drt {
+
+// Adaptive sampling: each pixel takes samples in rounds, each round as many as it has so far,
+// and stops once the estimated standard error of its mean luminance falls below the threshold,
+// or at the scene's sample count. The estimate is the sample deviation over sqrt(n), or for a
+// progressive sampler the spread of the means of 8 consecutive runs over sqrt(8), which credits
+// stratification. The decision reads only the pixel's own samples, so the image stays
+// independent of the thread count.
+struct AdaptiveSampling {
+    double noise_threshold = 0;  // in linear luminance units
+    int min_samples = 16;        // taken before the estimate is trusted; capped at the maximum
+};
+
+class RenderContext {
+  public:
+    // Throws std::invalid_argument for an unknown sampler name.
+    RenderContext(const Scene& scene, std::optional<AdaptiveSampling> adaptive);
+    // The integrator refers to the sampler, plan and BVH held here: the context stays put.
+    RenderContext(const RenderContext&) = delete;
+    RenderContext& operator=(const RenderContext&) = delete;
+
+    const Scene& scene() const { return scene_; }
+    const RenderPlan& plan() const { return plan_; }
+    // As applied: the minimum capped at the scene's sample count.
+    const std::optional<AdaptiveSampling>& adaptive() const { return adaptive_; }
+    // The whole image's tiles, row by row; a tile's index is its position here.
+    const std::vector<Tile>& tiles() const { return tiles_; }
+
+    // Renders every pixel of `tile`. Safe to call from several threads at once.
+    TileBuffer render_tile(const Tile& tile) const;
+
+  private:
+    // What one pixel's render leaves: its value, the camera samples it took, whether adaptive
+    // sampling stopped it early.
+    struct Pixel {
+        Color value;
+        std::uint32_t samples = 0;
+        bool converged = false;
+    };
+    // Reused from pixel to pixel of a tile: the radiance of each camera sample of the pixel in
+    // hand, and their luminances for the adaptive estimate.
+    struct Scratch {
+        std::vector<Color> colors;
+        std::vector<double> luminances;
+    };
+
+    Pixel plain_pixel(int x, int y, Scratch& scratch, RayCounts& rays) const;
+    Pixel adaptive_pixel(int x, int y, Scratch& scratch, RayCounts& rays) const;
+
+    const Scene& scene_;
+    std::unique_ptr<Sampler> sampler_;
+    RenderPlan plan_;
+    Bvh bvh_;
+    Integrator integrator_;
+    std::optional<AdaptiveSampling> adaptive_;
+    std::vector<Tile> tiles_;
+};
+
+}  // namespace drt

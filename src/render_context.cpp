@@ -1,0 +1,130 @@
+#include "drt/render_context.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "drt/rng.h"
+
+namespace drt {
+
+namespace {
+
+// The standard error of the mean of a pixel's sample values. Independent samples: the sample
+// deviation over sqrt(n). A progressive sampler's samples split into 8 consecutive runs that are
+// each a stratified pattern of their own, so the spread of the 8 run means over sqrt(8) measures
+// the error stratification leaves; the spread of single samples would overstate it at every edge
+// (by n^(1/4) for an edge, whose stratified error falls as n^(-3/4)).
+double standard_error(std::span<const double> v, bool progressive) {
+    constexpr std::size_t kRuns = 8;
+    const std::size_t n = v.size();
+    if (n < 2) return std::numeric_limits<double>::infinity();
+    const auto spread = [](std::span<const double> x) {  // sample variance
+        double mean = 0, m2 = 0;
+        for (std::size_t i = 0; i < x.size(); ++i) {
+            const double delta = x[i] - mean;
+            mean += delta / double(i + 1);
+            m2 += delta * (x[i] - mean);
+        }
+        return m2 / double(x.size() - 1);
+    };
+    if (!progressive || n < 2 * kRuns) return std::sqrt(spread(v) / double(n));
+    std::array<double, kRuns> means{};
+    for (std::size_t g = 0; g < kRuns; ++g) {
+        const std::size_t begin = g * n / kRuns, end = (g + 1) * n / kRuns;
+        for (std::size_t i = begin; i < end; ++i) means[g] += v[i];
+        means[g] /= double(end - begin);
+    }
+    return std::sqrt(spread(means) / double(kRuns));
+}
+
+std::unique_ptr<Sampler> sampler_named(const std::string& name) {
+    auto sampler = make_sampler(name);
+    if (!sampler) throw std::invalid_argument("unknown sampler '" + name + "'");
+    return sampler;
+}
+
+}  // namespace
+
+RenderContext::RenderContext(const Scene& scene, std::optional<AdaptiveSampling> adaptive)
+    : scene_(scene),
+      sampler_(sampler_named(scene.settings.sampler)),
+      plan_(plan_render(scene)),
+      bvh_(scene.objects),
+      integrator_(scene, plan_, bvh_, *sampler_),
+      adaptive_(adaptive),
+      tiles_(tile_grid(scene.settings.width, scene.settings.height)) {
+    if (adaptive_) {
+        adaptive_->min_samples = std::clamp(adaptive_->min_samples, 1, scene.settings.samples);
+    }
+}
+
+TileBuffer RenderContext::render_tile(const Tile& tile) const {
+    TileBuffer buffer{tile, Image(tile.width(), tile.height()), {}, {}, 0, 0};
+    buffer.pixel_samples.reserve(static_cast<std::size_t>(tile.width()) * tile.height());
+    Scratch scratch;
+    scratch.colors.resize(static_cast<std::size_t>(scene_.settings.samples));
+    for (int y = tile.y0; y < tile.y1; ++y) {
+        for (int x = tile.x0; x < tile.x1; ++x) {
+            const Pixel pixel = adaptive_ ? adaptive_pixel(x, y, scratch, buffer.rays)
+                                          : plain_pixel(x, y, scratch, buffer.rays);
+            buffer.pixels.set(x - tile.x0, y - tile.y0, pixel.value);
+            buffer.pixel_samples.push_back(pixel.samples);
+            buffer.samples += pixel.samples;
+            buffer.converged += pixel.converged ? 1 : 0;
+        }
+    }
+    return buffer;
+}
+
+RenderContext::Pixel RenderContext::plain_pixel(int x, int y, Scratch& scratch,
+                                                RayCounts& rays) const {
+    const auto spp = static_cast<std::uint32_t>(scene_.settings.samples);
+    const PixelSample s{scene_.settings.seed,
+                        static_cast<std::uint32_t>(y * scene_.settings.width + x), 0, spp};
+    integrator_.sample_pixel(x, y, s, scratch.colors, rays);
+    Color sum;
+    for (const Color& c : scratch.colors) sum += c;
+    return {sum / spp, spp, false};
+}
+
+// Rounds of as many samples as taken so far, until the standard error of the mean luminance is
+// below the threshold. A progressive sampler continues one pattern; any other starts a new
+// pattern of the round's size, on its own ray-tree path, in each round (the first round is
+// exactly a plain render at the minimum count).
+RenderContext::Pixel RenderContext::adaptive_pixel(int x, int y, Scratch& scratch,
+                                                   RayCounts& rays) const {
+    const auto spp = static_cast<std::uint32_t>(scene_.settings.samples);
+    const auto min_spp = static_cast<std::uint32_t>(adaptive_->min_samples);
+    const auto pixel = static_cast<std::uint32_t>(y * scene_.settings.width + x);
+    const bool progressive = sampler_->progressive();
+    std::vector<double>& luminances = scratch.luminances;
+    Color sum;
+    bool converged = false;
+    luminances.clear();
+    for (std::uint32_t round = 0;; ++round) {
+        const auto n = static_cast<std::uint32_t>(luminances.size());
+        const std::uint32_t batch = std::min(round == 0 ? min_spp : n, spp - n);
+        PixelSample s{scene_.settings.seed, pixel, 0, progressive ? spp : batch};
+        if (!progressive && round > 0) s.path = hash_of(0xada9717eULL, round);
+        s.index = progressive ? n : 0;
+        scratch.colors.resize(batch);
+        integrator_.sample_pixel(x, y, s, scratch.colors, rays);
+        for (const Color& c : scratch.colors) {
+            sum += c;
+            luminances.push_back(luminance(c));
+        }
+        if (luminances.size() >= spp) break;
+        if (standard_error(luminances, progressive) < adaptive_->noise_threshold) {
+            converged = true;
+            break;
+        }
+    }
+    const auto n = static_cast<std::uint32_t>(luminances.size());
+    return {sum / n, n, converged};
+}
+
+}  // namespace drt
