@@ -278,7 +278,28 @@ struct RenderJob {
     int threads = 0;
     bool quiet = false;
     bool progress = false;
+    bool exr_half = false;
 };
+
+// What an .exr header records about the render, so that the file says how it was made. The
+// render's estimated error (issue 14) belongs here too, as `estimatedError`.
+ImageWriteOptions output_options(const Scene& scene, const RenderResult& result,
+                                 const RenderJob& job) {
+    const RenderSettings& s = scene.settings;
+    ImageWriteOptions options;
+    options.half = job.exr_half;
+    options.attributes = {{"scene", scene.path},
+                          {"software", std::string("drt ") + DRT_VERSION},
+                          {"samplesPerPixel", s.samples},
+                          {"seed", std::to_string(s.seed)},  // 64 bits: no EXR number holds it
+                          {"sampler", s.sampler},
+                          {"renderSeconds", result.stats.seconds}};
+    if (const auto& a = result.stats.adaptive) {
+        options.attributes.push_back({"noiseThreshold", a->noise_threshold});
+        options.attributes.push_back({"minSamplesPerPixel", a->min_samples});
+    }
+    return options;
+}
 
 // Channel values that are NaN or infinite: radiance beyond the float range (a light of 1e39).
 std::size_t count_nonfinite(const Image& image) {
@@ -319,7 +340,7 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output, c
             result.stats.seconds > 0 ? result.stats.rays.total() / result.stats.seconds / 1e6 : 0;
         outcome.json = stats_json(scene, result);
         try {
-            write_image(result.image, output);
+            write_image(result.image, output, output_options(scene, result, job));
         } catch (const ImageError& e) {
             err << "drt: " << e.what() << "\n";
             outcome.status = kFailed;
@@ -393,7 +414,9 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
     bool force_progress = false;
     app.add_option("scenes", scenes, "Scene file(s) in the thesis XML format")->required();
     app.add_option("-o,--output", output,
-                   "Output image (.png, .bmp, .pfm); with several scenes, a folder");
+                   "Output image (.png, .bmp, .pfm, .exr); with several scenes, a folder");
+    app.add_flag("--exr-half", job.exr_half,
+                 "Write .exr channels as 16-bit half floats instead of 32-bit floats");
     job.overrides.add_to(app);
     job.adaptive.add_to(app);
     app.add_option("--threads", job.threads, "Worker threads (default: all cores)")
@@ -478,7 +501,7 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
 }
 
 int compare_command(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
-    CLI::App app{"Compare two images (.png, .bmp, .pfm) of equal size", "drt compare"};
+    CLI::App app{"Compare two images (.png, .bmp, .pfm, .exr) of equal size", "drt compare"};
     std::string a, b, diff;
     std::optional<double> max_rmse, min_psnr;
     app.add_option("A", a, "First image")->required();
@@ -486,7 +509,8 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
     app.add_option("--max-rmse", max_rmse, "Exit 1 when the RMSE exceeds X")
         ->check(CLI::NonNegativeNumber);
     app.add_option("--min-psnr", min_psnr, "Exit 1 when the PSNR falls below Y (dB)");
-    app.add_option("--diff", diff, "Write a false-colour difference image to D (.png, .bmp, .pfm)");
+    app.add_option("--diff", diff,
+                   "Write a false-colour difference image to D (.png, .bmp, .pfm, .exr)");
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp&) {
@@ -500,12 +524,11 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
     Image image_a, image_b;
     try {
         // Check every name before reading, so a typo costs nothing and writes nothing.
-        const bool linear_a = format_for_path(a) == ImageFormat::kPfm;
-        if (linear_a != (format_for_path(b) == ImageFormat::kPfm)) {
+        const bool linear_a = is_linear(format_for_path(a));
+        if (linear_a != is_linear(format_for_path(b))) {
             // Linear floats against sRGB-encoded bytes would measure the tone curve, not the image.
-            throw ImageError("cannot compare " + printable(linear_a ? a : b) +
-                             " (linear .pfm) with " + printable(linear_a ? b : a) +
-                             " (8-bit sRGB): convert one first");
+            throw ImageError("cannot compare " + printable(linear_a ? a : b) + " (linear) with " +
+                             printable(linear_a ? b : a) + " (8-bit sRGB): convert one first");
         }
         if (!diff.empty()) format_for_path(diff);
         image_a = read_image(a);
@@ -586,12 +609,13 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
     app.remove_option(app.get_option("--spp"));  // here a list, not one count
     app.add_option("--spp", counts_text, "Comma-separated sample counts (default 1,4,16,64,256)");
     app.add_option("--reference", reference_path,
-                   "Reference image (.pfm) to measure against; default: render one");
+                   "Reference image (.pfm or .exr) to measure against; default: render one");
     app.add_option("--reference-spp", reference_spp,
                    "Samples of the rendered reference (default 16 x the largest count, at most " +
                        std::to_string(kMaxSamples) + ")")
         ->check(integer_in(1, kMaxSamples));
-    app.add_option("--save-reference", save_reference, "Write the rendered reference to FILE.pfm");
+    app.add_option("--save-reference", save_reference,
+                   "Write the rendered reference to FILE (.pfm or .exr)");
     app.add_option("--csv", csv,
                    "Write spp,seconds,rmse,relmse,mean_spp,cpu_seconds,fitted rows to FILE");
     adaptive.add_to(app);
@@ -603,8 +627,9 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
         counts = parse_counts(counts_text);
         // Only linear floats measure the renderer's error; 8-bit files measure the tone curve.
         for (const std::string& f : {reference_path, save_reference}) {
-            if (!f.empty() && format_for_path(f) != ImageFormat::kPfm) {
-                throw CLI::ValidationError(f + ": the reference must be a linear .pfm image");
+            if (!f.empty() && !is_linear(format_for_path(f))) {
+                throw CLI::ValidationError(f +
+                                           ": the reference must be a linear .pfm or .exr image");
             }
         }
     } catch (const CLI::CallForHelp&) {

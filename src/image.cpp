@@ -20,6 +20,7 @@
 #include <system_error>
 
 #include "drt/atomic_file.h"
+#include "drt/exr.h"
 #include "drt/limits.h"
 #include "drt/text.h"
 
@@ -271,8 +272,13 @@ ImageFormat format_for_path(const fs::path& path) {
     if (ext == ".png") return ImageFormat::kPng;
     if (ext == ".bmp") return ImageFormat::kBmp;
     if (ext == ".pfm") return ImageFormat::kPfm;
-    fail(path,
-         "unsupported image format '" + path.extension().string() + "' (use .png, .bmp or .pfm)");
+    if (ext == ".exr") return ImageFormat::kExr;
+    fail(path, "unsupported image format '" + path.extension().string() +
+                   "' (use .png, .bmp, .pfm or .exr)");
+}
+
+bool is_linear(ImageFormat format) {
+    return format == ImageFormat::kPfm || format == ImageFormat::kExr;
 }
 
 unsigned char encode_srgb8(double linear) {
@@ -281,14 +287,15 @@ unsigned char encode_srgb8(double linear) {
     return static_cast<unsigned char>(std::lround(encoded * 255));
 }
 
-void write_image(const Image& image, const fs::path& path) {
+void write_image(const Image& image, const fs::path& path, const ImageWriteOptions& options) {
     const ImageFormat format = format_for_path(path);
     if (image.width <= 0 || image.height <= 0) fail(path, "cannot write an empty image");
     if (image.rgb.size() != 3 * static_cast<std::size_t>(image.width) * image.height) {
         fail(path, "image data does not match its size");
     }
-    const Bytes file =
-        format == ImageFormat::kPfm ? encode_pfm(image) : encode_8bit(image, format, path);
+    const Bytes file = format == ImageFormat::kPfm   ? encode_pfm(image)
+                       : format == ImageFormat::kExr ? encode_exr(image, options, path)
+                                                     : encode_8bit(image, format, path);
     try {
         replace_file(path, file);
     } catch (const FileWriteError& e) {
@@ -299,7 +306,14 @@ void write_image(const Image& image, const fs::path& path) {
 Image read_image(const fs::path& path) {
     const ImageFormat format = format_for_path(path);
     const Bytes data = read_file(path);
-    return format == ImageFormat::kPfm ? decode_pfm(data, path) : decode_8bit(data, format, path);
+    switch (format) {
+        case ImageFormat::kPfm:
+            return decode_pfm(data, path);
+        case ImageFormat::kExr:
+            return decode_exr(data, path);
+        default:
+            return decode_8bit(data, format, path);
+    }
 }
 
 }  // namespace drt

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "drt/image.h"
+#include "run_drt.h"
 
 namespace drt {
 namespace {
@@ -44,48 +45,7 @@ bool regex_search(const std::string& text, const char* pattern) {
 }
 
 namespace fs = std::filesystem;
-
-std::string read_bytes(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void write_bytes(const fs::path& path, const std::string& bytes) {
-    std::ofstream(path, std::ios::binary) << bytes;
-}
-
-struct Outcome {
-    int status = -1;
-    std::string out, err;
-};
-
-// Runs the drt binary with `args` in `cwd`, stdout and stderr captured through files (no pipe to
-// fill up), stdin closed.
-Outcome run_drt(const std::vector<std::string>& args, const fs::path& cwd) {
-    const fs::path out_file = cwd / ".drt_stdout", err_file = cwd / ".drt_stderr";
-    const pid_t pid = fork();
-    if (pid == 0) {
-        const int in = open("/dev/null", O_RDONLY);
-        const int out = open(out_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        const int err = open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (in < 0 || out < 0 || err < 0 || chdir(cwd.c_str()) != 0) _exit(127);
-        dup2(in, 0), dup2(out, 1), dup2(err, 2);
-        std::vector<char*> argv{const_cast<char*>(DRT_BINARY)};
-        for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-        argv.push_back(nullptr);
-        execv(DRT_BINARY, argv.data());
-        _exit(127);
-    }
-    int wstatus = 0;
-    waitpid(pid, &wstatus, 0);
-    Outcome r;
-    r.status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1;
-    r.out = read_bytes(out_file);
-    r.err = read_bytes(err_file);
-    fs::remove(out_file);
-    fs::remove(err_file);
-    return r;
-}
+using namespace test;
 
 // Runs drt with stdout and stderr on a pseudo-terminal and returns what the terminal showed.
 std::string run_drt_on_terminal(const std::vector<std::string>& args, const fs::path& cwd) {
@@ -712,6 +672,110 @@ TEST_F(CompareCliTest, DiffWritesAFalseColourImageOfTheSameSize) {
     const Outcome bad = run({"compare", "quarter.pfm", "spot.pfm", "--diff", "no/such/d.png"});
     EXPECT_EQ(bad.status, 1);
     EXPECT_EQ(bad.out.rfind("rmse=", 0), 0u);
+}
+
+// ---- OpenEXR ------------------------------------------------------------------------------------
+
+// Runs a shell command line and returns its standard output.
+std::string shell_output(const std::string& command) {
+    std::string text;
+    const std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(command.c_str(), "r"), pclose);
+    if (!pipe) return text;
+    char buf[4096];
+    for (std::size_t n; (n = fread(buf, 1, sizeof buf, pipe.get())) > 0;) text.append(buf, n);
+    return text;
+}
+
+TEST_F(CliTest, ExrOutputHasTheRendersFloatsAndSaysHowItWasMade) {
+    ASSERT_EQ(
+        run({"scene.xml", "-q", "--spp", "3", "--seed", "11", "--sampler", "sobol", "-o", "a.exr"})
+            .status,
+        0);
+    ASSERT_EQ(
+        run({"scene.xml", "-q", "--spp", "3", "--seed", "11", "--sampler", "sobol", "-o", "a.pfm"})
+            .status,
+        0);
+    const Image exr = read_image(file("a.exr")), pfm = read_image(file("a.pfm"));
+    EXPECT_EQ(exr.rgb, pfm.rgb);  // the same floats as the .pfm, bit for bit
+
+    // OpenEXR's own tool lists the attributes with their types.
+    const std::string header = shell_output("exrheader " + file("a.exr").string() + " 2>&1");
+    ASSERT_NE(header.find("file format version: 2"), std::string::npos)
+        << "exrheader (Debian package openexr, tools/install-deps.sh) failed: " << header;
+    for (const char* expected : {
+             "scene (type string): \"scene.xml\"",
+             "software (type string): \"drt " DRT_VERSION "\"",
+             "samplesPerPixel (type int): 3",
+             "seed (type string): \"11\"",
+             "sampler (type string): \"sobol\"",
+             "renderSeconds (type double): ",
+             "R, 32-bit floating-point",
+             "compression (type compression): zip",
+         }) {
+        EXPECT_NE(header.find(expected), std::string::npos) << expected << "\n" << header;
+    }
+
+    // --exr-half: 16-bit channels, values within half's precision.
+    ASSERT_EQ(run({"scene.xml", "-q", "--spp", "3", "--seed", "11", "--sampler", "sobol",
+                   "--exr-half", "-o", "h.exr"})
+                  .status,
+              0);
+    EXPECT_NE(shell_output("exrheader " + file("h.exr").string()).find("R, 16-bit floating-point"),
+              std::string::npos);
+    const Image half = read_image(file("h.exr"));
+    for (std::size_t i = 0; i < half.rgb.size(); ++i) {
+        ASSERT_NEAR(half.rgb[i], pfm.rgb[i], std::abs(pfm.rgb[i]) * 0x1p-11 + 0x1p-25) << i;
+    }
+}
+
+TEST_F(CliTest, AdaptiveRenderRecordsItsThresholdInTheExrHeader) {
+    ASSERT_EQ(run({"scene.xml", "-q", "--spp", "32", "--noise-threshold", "0.05", "--min-spp", "4",
+                   "-o", "a.exr"})
+                  .status,
+              0);
+    const std::string header = shell_output("exrheader " + file("a.exr").string());
+    EXPECT_NE(header.find("noiseThreshold (type double): 0.05"), std::string::npos) << header;
+    EXPECT_NE(header.find("minSamplesPerPixel (type int): 4"), std::string::npos) << header;
+    EXPECT_NE(header.find("samplesPerPixel (type int): 32"), std::string::npos) << header;
+}
+
+TEST_F(CompareCliTest, ExrComparesWithPfmButNotWithEightBitFiles) {
+    write_image(constant(4, 3, 0.25f), file("quarter.exr"));
+    const Outcome same = run({"compare", "quarter.exr", "quarter.pfm", "--max-rmse", "0"});
+    EXPECT_EQ(same.status, 0) << same.err;
+    EXPECT_EQ(same.out.rfind("rmse=0 psnr=inf ssim=1 ", 0), 0u) << same.out;
+    const Outcome differ = run({"compare", "half.pfm", "quarter.exr", "--diff", "d.exr"});
+    EXPECT_EQ(differ.out.rfind("rmse=0.25 psnr=12.0412 ", 0), 0u) << differ.out;
+    EXPECT_EQ(read_image(file("d.exr")).width, 4);
+
+    write_image(constant(4, 3, 0.25f), file("quarter.png"));
+    const Outcome mixed = run({"compare", "quarter.exr", "quarter.png"});
+    EXPECT_EQ(mixed.status, 2);
+    EXPECT_NE(mixed.err.find("cannot compare quarter.exr (linear) with quarter.png (8-bit sRGB)"),
+              std::string::npos)
+        << mixed.err;
+}
+
+TEST_F(CompareCliTest, CorruptOrTruncatedExrExitsTwoNamingTheFile) {
+    write_image(constant(40, 30, 0.25f), file("good.exr"));
+    const std::string bytes = read_bytes(file("good.exr"));
+    std::string flipped = bytes;
+    for (std::size_t i = bytes.size() / 2; i < bytes.size(); i += 7) flipped[i] ^= 0x5a;
+    const std::vector<std::pair<std::string, std::string>> bad{
+        {"empty.exr", ""},
+        {"text.exr", "not an exr file"},
+        {"header-only.exr", bytes.substr(0, bytes.size() / 3)},
+        {"cut.exr", bytes.substr(0, bytes.size() - 10)},
+        {"flipped.exr", flipped},
+    };
+    for (const auto& [name, content] : bad) {
+        write_bytes(file(name), content);
+        const Outcome r = run({"compare", name, "good.exr", "--diff", "d.png"});
+        EXPECT_EQ(r.status, 2) << name << ": " << r.err;
+        EXPECT_EQ(r.err.rfind("drt compare: " + name + ": ", 0), 0u) << r.err;
+        EXPECT_EQ(r.out, "");
+    }
+    EXPECT_FALSE(fs::exists(file("d.png")));
 }
 
 // ---- progress

@@ -201,6 +201,14 @@ TEST(ConvergeCli, PrintsOneRowPerCountAndWritesTheCsv) {
         return values;
     };
     EXPECT_EQ(rmse_column(read_text(csv2)), rmse_column(csv));
+
+    // The same reference as an OpenEXR file measures the same.
+    write_image(read_image(dir / "ref.pfm"), dir / "ref.exr");
+    const CliRun exr =
+        run({"converge", scene, "--scale", "0.05", "--spp", "2,8", "--sampler", "sobol", "--seed",
+             "7", "--csv", csv2.string(), "--reference", (dir / "ref.exr").string()});
+    ASSERT_EQ(exr.status, 0) << exr.err;
+    EXPECT_EQ(rmse_column(read_text(csv2)), rmse_column(csv));
     fs::remove_all(dir);
 }
 
@@ -212,7 +220,8 @@ TEST(ConvergeCli, RefusesBadInput) {
         << r.err;
     r = run({"converge", scene, "--reference", "ref.png"});
     EXPECT_EQ(r.status, 2);
-    EXPECT_NE(r.err.find("ref.png: the reference must be a linear .pfm image"), std::string::npos)
+    EXPECT_NE(r.err.find("ref.png: the reference must be a linear .pfm or .exr image"),
+              std::string::npos)
         << r.err;
     r = run({"converge", scene, "--reference", "/nonexistent/ref.pfm", "--scale", "0.05"});
     EXPECT_EQ(r.status, 2);

@@ -67,12 +67,13 @@ std::uint32_t le32(const std::string& s, std::size_t offset) {
     return v;
 }
 
-TEST(FormatForPath, KnowsTheThreeExtensionsInAnyCase) {
+TEST(FormatForPath, KnowsTheFourExtensionsInAnyCase) {
     EXPECT_EQ(format_for_path("a.png"), ImageFormat::kPng);
     EXPECT_EQ(format_for_path("dir.x/a.PnG"), ImageFormat::kPng);
     EXPECT_EQ(format_for_path("a.BMP"), ImageFormat::kBmp);
     EXPECT_EQ(format_for_path("/tmp/a.pfm"), ImageFormat::kPfm);
     EXPECT_EQ(format_for_path("a.Pfm"), ImageFormat::kPfm);
+    EXPECT_EQ(format_for_path("a.eXr"), ImageFormat::kExr);
 }
 
 TEST(FormatForPath, RejectsOtherExtensionsNamingTheFile) {
@@ -80,8 +81,9 @@ TEST(FormatForPath, RejectsOtherExtensionsNamingTheFile) {
         format_for_path("out/render.jpg");
         FAIL() << "no exception";
     } catch (const ImageError& e) {
-        EXPECT_STREQ(e.what(),
-                     "out/render.jpg: unsupported image format '.jpg' (use .png, .bmp or .pfm)");
+        EXPECT_STREQ(
+            e.what(),
+            "out/render.jpg: unsupported image format '.jpg' (use .png, .bmp, .pfm or .exr)");
     }
     EXPECT_THROW(format_for_path("render"), ImageError);
     EXPECT_THROW(format_for_path("render.png.tmp"), ImageError);

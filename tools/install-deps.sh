@@ -5,7 +5,8 @@
 #   --bench  also libbenchmark-dev, povray and time, which bench/ needs (docs/performance.md)
 set -euo pipefail
 
-packages=(g++ cmake make pkg-config libtinyxml2-dev libstb-dev libcli11-dev libgtest-dev)
+packages=(g++ cmake make pkg-config libtinyxml2-dev libstb-dev libcli11-dev libopenexr-dev
+          libgtest-dev openexr)
 for arg in "$@"; do
     case "$arg" in
         --study) packages+=(gnuplot-nox) ;;

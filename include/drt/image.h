@@ -3,6 +3,8 @@
 
 #include <filesystem>
 #include <stdexcept>
+#include <string>
+#include <variant>
 #include <vector>
 
 #include "drt/color.h"
@@ -28,7 +30,22 @@ struct Image {
     }
 };
 
-enum class ImageFormat { kPng, kBmp, kPfm };
+enum class ImageFormat { kPng, kBmp, kPfm, kExr };
+
+// .pfm and .exr hold linear values; .png and .bmp hold 8-bit sRGB-encoded ones.
+bool is_linear(ImageFormat format);
+
+// A named value stored in the file's header. Only .exr files have a place for these; the other
+// formats ignore them.
+struct ImageAttribute {
+    std::string name;
+    std::variant<std::string, int, double> value;
+};
+
+struct ImageWriteOptions {
+    bool half = false;  // .exr: 16-bit half floats instead of 32-bit floats
+    std::vector<ImageAttribute> attributes;
+};
 
 // A file that cannot be read, written or understood; the message names the file.
 class ImageError : public std::runtime_error {
@@ -42,11 +59,12 @@ ImageFormat format_for_path(const std::filesystem::path& path);
 // sRGB transfer curve of a linear value clamped to [0, 1], rounded to 8 bits.
 unsigned char encode_srgb8(double linear);
 
-// Writes .png/.bmp (8-bit sRGB-encoded) or .pfm (linear float). The file appears complete or
+// Writes .png/.bmp (8-bit sRGB-encoded), .pfm or .exr (linear float). The file appears complete or
 // not at all: data goes to a temporary file in the same folder, which is then renamed.
-void write_image(const Image& image, const std::filesystem::path& path);
+void write_image(const Image& image, const std::filesystem::path& path,
+                 const ImageWriteOptions& options = {});
 
-// Reads .png/.bmp as stored values / 255 (still sRGB-encoded) and .pfm as its floats.
+// Reads .png/.bmp as stored values / 255 (still sRGB-encoded), .pfm and .exr as their floats.
 Image read_image(const std::filesystem::path& path);
 
 }  // namespace drt

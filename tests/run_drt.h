@@ -1,0 +1,60 @@
+// Running the built drt binary as a user does, and the file helpers its tests share.
+#pragma once
+
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+namespace drt::test {
+
+namespace fs = std::filesystem;
+
+inline std::string read_bytes(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+inline void write_bytes(const fs::path& path, const std::string& bytes) {
+    std::ofstream(path, std::ios::binary) << bytes;
+}
+
+struct Outcome {
+    int status = -1;
+    std::string out, err;
+};
+
+// Runs the drt binary with `args` in `cwd`, stdout and stderr captured through files (no pipe to
+// fill up), stdin closed.
+inline Outcome run_drt(const std::vector<std::string>& args, const fs::path& cwd) {
+    const fs::path out_file = cwd / ".drt_stdout", err_file = cwd / ".drt_stderr";
+    const pid_t pid = fork();
+    if (pid == 0) {
+        const int in = open("/dev/null", O_RDONLY);
+        const int out = open(out_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        const int err = open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (in < 0 || out < 0 || err < 0 || chdir(cwd.c_str()) != 0) _exit(127);
+        dup2(in, 0), dup2(out, 1), dup2(err, 2);
+        std::vector<char*> argv{const_cast<char*>(DRT_BINARY)};
+        for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+        argv.push_back(nullptr);
+        execv(DRT_BINARY, argv.data());
+        _exit(127);
+    }
+    int wstatus = 0;
+    waitpid(pid, &wstatus, 0);
+    Outcome r;
+    r.status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1;
+    r.out = read_bytes(out_file);
+    r.err = read_bytes(err_file);
+    fs::remove(out_file);
+    fs::remove(err_file);
+    return r;
+}
+
+}  // namespace drt::test
