@@ -84,39 +84,42 @@ struct Bvh::RayData {
 Bvh::Bvh(const std::vector<std::unique_ptr<Object>>& objects) {
     std::vector<Primitive> pieces;
     std::vector<Build> items;
+    auto add = [&](const Primitive& p, const Bounds& bounds) {
+        items.push_back({bounds, p.time, static_cast<std::uint32_t>(pieces.size())});
+        pieces.push_back(p);
+    };
     for (const auto& owned : objects) {
-        const Object* object = owned.get();
-        if (const auto* plane = dynamic_cast<const drt::Plane*>(object)) {
-            planes_.push_back({plane->point(), plane->normal(), max_abs_component(plane->point()),
-                               dot(plane->point(), plane->normal()), object});
-            continue;
+        const auto object = static_cast<std::uint32_t>(objects_.size());
+        objects_.push_back(owned.get());
+        const Shapes shapes = owned->shapes();
+        for (std::uint32_t i = 0; i < shapes.planes.size(); ++i) {
+            const PlaneShape& plane = shapes.planes[i];
+            planes_.push_back({plane.point, plane.normal, max_abs_component(plane.point),
+                               dot(plane.point, plane.normal), object, i});
         }
-        const std::vector<TimedBounds> bounds = object->motion_bounds();
-        if (bounds.empty()) {
-            unbounded_.push_back(object);
-            continue;
-        }
-        const auto* sphere = dynamic_cast<const Sphere*>(object);
-        for (std::size_t k = 0; k < bounds.size(); ++k) {
-            Primitive p{};
-            p.object = object;
-            p.time = bounds[k].time;
-            p.kind = Kind::kOther;
-            if (sphere) {
-                // One piece per path segment (Sphere::motion_bounds), segment k from path[k].
-                const std::vector<Vec3>& path = sphere->path();
-                p.centre = path[k];
-                p.radius = sphere->radius();
-                p.kind = path.size() == 1 ? Kind::kStillSphere : Kind::kMovingSphere;
-                if (p.kind == Kind::kMovingSphere) {
-                    p.motion = static_cast<std::uint32_t>(motions_.size());
-                    motions_.push_back(
-                        {path[k + 1] - path[k], path[k + 1], static_cast<double>(k)});
-                }
+        for (std::uint32_t i = 0; i < shapes.spheres.size(); ++i) {
+            const MotionPath& path = *shapes.spheres[i].path;
+            const double radius = shapes.spheres[i].radius;
+            const Vec3 r{radius, radius, radius};
+            if (!path.moves()) {
+                const Vec3 c = path.at(0);
+                add({c, radius, {-kInfinity, kInfinity}, object, i, Kind::kStillSphere, 0},
+                    Bounds{}.grow(c - r).grow(c + r));
+                continue;
             }
-            items.push_back(
-                {bounds[k].bounds, bounds[k].time, static_cast<std::uint32_t>(pieces.size())});
-            pieces.push_back(p);
+            // One piece per segment, bounded over the segment's time span only.
+            for (std::size_t k = 0; k < path.segment_count(); ++k) {
+                const PathSegment segment = path.segment(k);
+                const auto motion = static_cast<std::uint32_t>(motions_.size());
+                motions_.push_back(segment);
+                add({segment.from, radius, path.segment_time(k), object, i, Kind::kMovingSphere,
+                     motion},
+                    Bounds{}
+                        .grow(segment.from - r)
+                        .grow(segment.from + r)
+                        .grow(segment.to - r)
+                        .grow(segment.to + r));
+            }
         }
     }
     if (items.empty()) return;
@@ -206,44 +209,30 @@ std::uint32_t Bvh::build(std::vector<Build>& items, std::uint32_t begin, std::ui
     return index;
 }
 
-std::optional<double> Bvh::hit_primitive(const Primitive& p, const Ray& ray, double origin_scale,
-                                         Interval range) const {
-    switch (p.kind) {
-        case Kind::kStillSphere:
-            return intersect_sphere(p.centre, p.radius, ray, origin_scale, range);
-        case Kind::kMovingSphere: {
-            if (!p.time.contains(ray.time)) return std::nullopt;
-            // Sphere::centre_at's interpolation, to the bit: the ends exactly, lerp in between.
-            const Motion& m = motions_[p.motion];
-            const double f = ray.time - m.start;
-            const Vec3 centre = f <= 0 ? p.centre : (f >= 1 ? m.end : p.centre + m.delta * f);
-            return intersect_sphere(centre, p.radius, ray, origin_scale, range);
-        }
-        case Kind::kOther:
-            if (!p.time.contains(ray.time)) return std::nullopt;
-            return p.object->intersect(ray, range);
+std::optional<double> Bvh::hit(const Primitive& p, const Ray& ray, double origin_scale,
+                               Interval range, Vec2& /*uv*/) const {
+    // Still spheres, the common case, first.
+    if (p.kind == Kind::kStillSphere) {
+        return intersect_sphere(p.centre, p.radius, ray, origin_scale, range);
     }
-    return std::nullopt;
+    if (!p.time.contains(ray.time)) return std::nullopt;
+    return intersect_sphere(motions_[p.motion].at(ray.time), p.radius, ray, origin_scale, range);
+}
+
+Ball Bvh::ball_at(const Primitive& p, double time) const {
+    return {p.kind == Kind::kStillSphere ? p.centre : motions_[p.motion].at(time), p.radius};
 }
 
 template <bool kAnyHit>
-std::optional<Intersection> Bvh::traverse(const Ray& ray, Interval range,
-                                          const Occluders& occluders) const {
+std::optional<Hit> Bvh::traverse(const Ray& ray, Interval range, const Occluders& occluders) const {
     const double origin_scale = max_abs_component(ray.origin);
-    std::optional<Intersection> nearest;
+    std::optional<Hit> nearest;
     for (std::size_t i = 0; i < planes_.size(); ++i) {
         if (i < 64 && (occluders.planes >> i & 1) == 0) continue;
         const PlaneData& plane = planes_[i];
         if (auto t = intersect_plane(plane.point, plane.normal, plane.point_scale, ray,
                                      origin_scale, range)) {
-            nearest = Intersection{*t, plane.object};
-            if constexpr (kAnyHit) return nearest;
-            range.max = *t;
-        }
-    }
-    for (const Object* object : unbounded_) {
-        if (auto t = object->intersect(ray, range)) {
-            nearest = Intersection{*t, object};
+            nearest = Hit{*t, objects_[plane.object], plane.index, {}};
             if constexpr (kAnyHit) return nearest;
             range.max = *t;
         }
@@ -253,11 +242,9 @@ std::optional<Intersection> Bvh::traverse(const Ray& ray, Interval range,
     auto leaf = [&](const Node& node) {
         for (std::uint32_t i = node.offset; i < node.offset + node.count; ++i) {
             const Primitive& p = primitives_[i];
-            // Still spheres, the common case, inline; the rest out of line.
-            if (auto t = p.kind == Kind::kStillSphere
-                             ? intersect_sphere(p.centre, p.radius, ray, origin_scale, range)
-                             : hit_primitive(p, ray, origin_scale, range)) {
-                nearest = Intersection{*t, p.object};
+            Vec2 uv;
+            if (auto t = hit(p, ray, origin_scale, range, uv)) {
+                nearest = Hit{*t, objects_[p.object], p.index, uv};
                 if constexpr (kAnyHit) return true;
                 range.max = *t;
             }
@@ -311,7 +298,7 @@ std::optional<Intersection> Bvh::traverse(const Ray& ray, Interval range,
     }
 }
 
-std::optional<Intersection> Bvh::intersect(const Ray& ray, Interval range) const {
+std::optional<Hit> Bvh::intersect(const Ray& ray, Interval range) const {
     return traverse<false>(ray, range, Occluders{});
 }
 
@@ -334,16 +321,9 @@ bool Bvh::occluded(const Ray& ray, Interval range, const Occluders& occluders) c
         if (intersect_plane(p.point, p.normal, p.point_scale, ray, origin_scale, range))
             return true;
     }
-    for (const Object* object : unbounded_) {
-        if (object->intersect(ray, range)) return true;
-    }
     for (int i = 0; i < occluders.count; ++i) {
-        const Primitive& p = primitives_[occluders.primitives[i]];
-        if (p.kind == Kind::kStillSphere
-                ? intersect_sphere(p.centre, p.radius, ray, origin_scale, range).has_value()
-                : hit_primitive(p, ray, origin_scale, range).has_value()) {
-            return true;
-        }
+        Vec2 uv;
+        if (hit(primitives_[occluders.primitives[i]], ray, origin_scale, range, uv)) return true;
     }
     return false;
 }
@@ -417,7 +397,7 @@ Occluders Bvh::gather_occluders(const Vec3& origin, const Ball& target, double t
         found.planes |= std::uint64_t{!apart} << i;
     }
 
-    const bool only_listed = planes_.size() <= 64 && unbounded_.empty();
+    const bool only_listed = planes_.size() <= 64;
     if (nodes_.empty()) {
         found.everything = false;
         found.nothing = only_listed && found.planes == 0;
@@ -443,16 +423,8 @@ Occluders Bvh::gather_occluders(const Vec3& origin, const Ball& target, double t
         for (std::uint32_t i = node.offset; i < node.offset + node.count; ++i) {
             const Primitive& p = primitives_[i];
             if (!p.time.contains(time)) continue;
-            bool may_block = true;
-            if (p.kind == Kind::kStillSphere) {
-                may_block = cone.may_meet(p.centre, p.radius);
-            } else if (p.kind == Kind::kMovingSphere) {
-                const Motion& m = motions_[p.motion];
-                const double f = time - m.start;
-                const Vec3 centre = f <= 0 ? p.centre : (f >= 1 ? m.end : p.centre + m.delta * f);
-                may_block = cone.may_meet(centre, p.radius);
-            }
-            if (!may_block) continue;
+            const Ball ball = ball_at(p, time);
+            if (!cone.may_meet(ball.centre, ball.radius)) continue;
             if (found.count == Occluders::kMaxListed) return found;  // too many: traverse instead
             found.primitives[found.count++] = i;
         }
@@ -460,22 +432,6 @@ Occluders Bvh::gather_occluders(const Vec3& origin, const Ball& target, double t
     found.everything = false;
     found.nothing = only_listed && found.planes == 0 && found.count == 0;
     return found;
-}
-
-std::size_t Bvh::depth() const {
-    std::size_t deepest = 0;
-    if (nodes_.empty()) return 0;
-    std::vector<std::pair<std::uint32_t, std::size_t>> stack{{0, 1}};
-    while (!stack.empty()) {
-        const auto [node, d] = stack.back();
-        stack.pop_back();
-        deepest = std::max(deepest, d);
-        if (nodes_[node].count == 0) {
-            stack.push_back({node + 1, d + 1});
-            stack.push_back({nodes_[node].offset, d + 1});
-        }
-    }
-    return deepest;
 }
 
 }  // namespace drt

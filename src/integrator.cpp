@@ -91,7 +91,7 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
     if (!hit) return scene_.background;
 
     const Material& m = hit->object->material();
-    const SurfaceHit surface = hit->object->surface_at(ray, hit->t);
+    const SurfaceHit surface = hit->object->surface_at(ray, *hit);
     // Face both normals towards the incoming ray: planes are two-sided, and a ray inside a
     // sphere sees its inner side.
     const bool outside = dot(ray.dir, surface.normal) < 0;

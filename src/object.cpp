@@ -2,17 +2,15 @@
 
 namespace drt {
 
-SurfaceHit Object::surface_at(const Ray& ray, double t) const {
-    SurfaceHit hit;
-    hit.point = project_to_surface(ray.at(t), ray.time);
-    hit.normal = outward_normal(hit.point, ray.time);
-    hit.shading_normal = hit.normal;
-    if (detail_.bump) {
-        hit.shading_normal = detail_.bump->perturb(hit.normal, bump_point(hit.point, ray.time));
-    }
-    hit.kd = detail_.texture ? detail_.texture->value(texture_point(hit.point, ray.time))
-                             : material_->kd;
-    return hit;
+SurfaceHit Object::surface_at(const Ray& ray, const Hit& hit) const {
+    const SurfacePoint at = locate(ray, hit);
+    SurfaceHit surface;
+    surface.point = at.point;
+    surface.normal = at.normal;
+    surface.shading_normal =
+        detail_.bump ? detail_.bump->perturb(at.shading_normal, at.bump_point) : at.shading_normal;
+    surface.kd = detail_.texture ? detail_.texture->value(at.texture_point) : material_->kd;
+    return surface;
 }
 
 }  // namespace drt

@@ -26,17 +26,17 @@ Plane::Plane(Vec3 point, Vec3 normal, const Material& material, SurfaceDetail de
       frame_(plane_frame(normalize(normal))),
       offset_(dot(frame_.n, point)) {}
 
-std::optional<double> Plane::intersect(const Ray& ray, Interval range) const {
-    return intersect_plane(point_, frame_.n, max_abs_component(point_), ray,
-                           max_abs_component(ray.origin), range);
+std::optional<Hit> Plane::intersect(const Ray& ray, Interval range) const {
+    const auto t = intersect_plane(point_, frame_.n, max_abs_component(point_), ray,
+                                   max_abs_component(ray.origin), range);
+    if (!t) return std::nullopt;
+    return Hit{*t, this, 0, {}};
 }
 
-Vec3 Plane::project_to_surface(const Vec3& p, double) const {
-    return p - frame_.n * (dot(p, frame_.n) - offset_);
-}
-
-Vec3 Plane::texture_point(const Vec3& point, double) const {
-    return {dot(point, frame_.t), dot(point, frame_.b), 0};
+Object::SurfacePoint Plane::locate(const Ray& ray, const Hit& hit) const {
+    const Vec3 p = ray.at(hit.t);
+    const Vec3 point = p - frame_.n * (dot(p, frame_.n) - offset_);
+    return {point, frame_.n, frame_.n, {dot(point, frame_.t), dot(point, frame_.b), 0}, point};
 }
 
 }  // namespace drt

@@ -56,12 +56,12 @@ struct World {
         }
     }
 
-    std::optional<Intersection> brute_nearest(const Ray& ray, Interval range) const {
-        std::optional<Intersection> nearest;
+    std::optional<Hit> brute_nearest(const Ray& ray, Interval range) const {
+        std::optional<Hit> nearest;
         for (const auto& object : objects) {
-            if (auto t = object->intersect(ray, range)) {
-                nearest = Intersection{*t, object.get()};
-                range.max = *t;
+            if (auto hit = object->intersect(ray, range)) {
+                nearest = hit;
+                range.max = hit->t;
             }
         }
         return nearest;
@@ -88,6 +88,7 @@ TEST(Bvh, NearestHitIsThatOfTestingEveryObject) {
             ++hits;
             EXPECT_EQ(got->t, expected->t) << count << " ray " << i;
             EXPECT_EQ(got->object, expected->object) << count << " ray " << i;
+            EXPECT_EQ(got->primitive, expected->primitive) << count << " ray " << i;
         }
         EXPECT_GT(hits, 1000) << count;
     }
@@ -147,6 +148,66 @@ TEST(Bvh, MovingSphereIsHitOnlyWhereItIsAtTheRaysTime) {
     }
 }
 
+// At the ends of a path's segments, where two BVH pieces meet and the time within a segment
+// rounds, the BVH places a moving sphere exactly where the sphere itself says it is: the same
+// hit to the bit, for rays grazing its edge as well as through its middle.
+TEST(Bvh, MovingSphereAtSegmentEndsIsWhereTheSphereSaysToTheBit) {
+    Material material;
+    std::vector<std::unique_ptr<Object>> objects;
+    objects.push_back(std::make_unique<Sphere>(
+        std::vector<Vec3>{{0.1, 0.2, 0.3}, {10.7, -0.9, 1e-3}, {20.3, 3.1, -2.9}}, 1.3, material));
+    const auto& sphere = *objects[0];
+    const Bvh bvh(objects);
+    int hits = 0;
+    for (const double end : {0.0, 1.0, 2.0}) {
+        for (const double time :
+             {std::nextafter(end, -kInfinity), end, std::nextafter(end, kInfinity)}) {
+            const Vec3 c = dynamic_cast<const Sphere&>(sphere).path().at(time);
+            for (const double off : {0.0, 0.7, 1.2999999}) {
+                const Ray ray{c + Vec3{off, 0, -10}, {0, 0, 1}, time};
+                const auto expected = sphere.intersect(ray, {0, kInfinity});
+                const auto got = bvh.intersect(ray, {0, kInfinity});
+                ASSERT_TRUE(expected) << time << " " << off;
+                ASSERT_TRUE(got) << time << " " << off;
+                EXPECT_EQ(got->t, expected->t) << time << " " << off;
+                ++hits;
+            }
+        }
+    }
+    EXPECT_EQ(hits, 27);
+}
+
+// The hit record names the object and its shape, and the surface worked out from it lies where
+// the ray met it: on the sphere (at the ray's time) or the plane, at ray.at(t).
+TEST(Bvh, SurfaceOfAHitRecordIsWhereTheRayMetTheShape) {
+    const World world(40, 13);
+    const Bvh bvh(world.objects);
+    int spheres = 0, planes = 0;
+    for (std::uint64_t i = 0; i < 2000; ++i) {
+        const Ray ray{point_in(23, i, 1, 99), direction(24, i), 2.5 * unit(25, i)};
+        const auto hit = bvh.intersect(ray, {0, kInfinity});
+        if (!hit) continue;
+        ASSERT_NE(hit->object, nullptr);
+        EXPECT_EQ(hit->primitive, 0u);  // each object here is one shape
+        const SurfaceHit surface = hit->object->surface_at(ray, *hit);
+        EXPECT_LT(length(surface.point - ray.at(hit->t)), 1e-12 * (100 + hit->t)) << i;
+        EXPECT_NEAR(length(surface.normal), 1.0, 1e-15) << i;
+        if (const auto* sphere = dynamic_cast<const Sphere*>(hit->object)) {
+            const Vec3 c = sphere->path().at(ray.time);
+            EXPECT_NEAR(length(surface.point - c), sphere->radius(), 1e-13 * 100) << i;
+            EXPECT_LT(length(surface.normal - (surface.point - c) / sphere->radius()), 1e-13);
+            ++spheres;
+        } else {
+            const auto& plane = dynamic_cast<const Plane&>(*hit->object);
+            EXPECT_NEAR(dot(surface.point - plane.point(), plane.normal()), 0, 1e-13) << i;
+            EXPECT_EQ(surface.normal, plane.normal());
+            ++planes;
+        }
+    }
+    EXPECT_GT(spheres, 100);
+    EXPECT_GT(planes, 100);
+}
+
 // Shadow rays from points on and off the surfaces to points of a light: the gathered occluders
 // must give exactly the answer of the whole scene, from a floor point, a sphere's surface, a
 // point in free space, and with more spheres in the way than the list holds.
@@ -165,7 +226,7 @@ TEST(Bvh, GatheredOccludersNeverChangeAShadowRaysAnswer) {
                 const auto* sphere =
                     dynamic_cast<const Sphere*>(world.objects[3 + p % count].get());
                 normal = direction(46, p);
-                point = sphere->centre_at(time) + normal * sphere->radius();
+                point = sphere->path().at(time) + normal * sphere->radius();
             }
             const Ray leaving = spawn_ray(point, normal, normal, time);
             const Occluders occluders = bvh.gather_occluders(leaving.origin, light, time);

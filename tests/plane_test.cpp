@@ -39,28 +39,28 @@ SurfaceHit surface_at_point(const Plane& plane, const Vec3& p) {
     const Ray ray{p + plane.normal() * 10.0, -plane.normal()};
     const auto t = plane.intersect(ray, {});
     EXPECT_TRUE(t);
-    return plane.surface_at(ray, t.value_or(10.0));
+    return plane.surface_at(ray, t.value_or(Hit{10.0, &plane, 0, {}}));
 }
 
 TEST(Plane, HitDistanceIsAnalytic) {
     const Plane floor({0, 0, 0}, {0, 1, 0}, plain_material());
     const auto down = floor.intersect({{1, 5, 2}, {0, -1, 0}}, {});
     ASSERT_TRUE(down);
-    EXPECT_DOUBLE_EQ(*down, 5.0);
+    EXPECT_DOUBLE_EQ(down->t, 5.0);
     // A 3-4-5 triangle.
     const auto oblique = floor.intersect({{0, 4, 0}, {0.6, -0.8, 0}}, {});
     ASSERT_TRUE(oblique);
-    EXPECT_NEAR(*oblique, 5.0, 1e-15);
+    EXPECT_NEAR(oblique->t, 5.0, 1e-15);
     // No back-face culling: a ray from below meets it too.
     const auto up = floor.intersect({{7, -3, 1}, {0, 1, 0}}, {});
     ASSERT_TRUE(up);
-    EXPECT_DOUBLE_EQ(*up, 3.0);
+    EXPECT_DOUBLE_EQ(up->t, 3.0);
 
     // Through (1, 2, 3) with normal along (1, 1, 1): distance from the origin 6/sqrt(3).
     const Plane tilted({1, 2, 3}, {1, 1, 1}, plain_material());
     const auto diagonal = tilted.intersect({{0, 0, 0}, normalize(Vec3{1, 1, 1})}, {});
     ASSERT_TRUE(diagonal);
-    EXPECT_NEAR(*diagonal, 2.0 * std::sqrt(3.0), 1e-14);
+    EXPECT_NEAR(diagonal->t, 2.0 * std::sqrt(3.0), 1e-14);
 }
 
 TEST(Plane, PlaneBehindOrBeyondTheRangeIsMissed) {
@@ -112,7 +112,7 @@ TEST(Plane, SurfaceAtProjectsOntoThePlane) {
         if (!t) continue;
         const SurfaceHit hit = plane.surface_at({start, d}, *t);
         EXPECT_NEAR(dot(hit.point - p, n), 0.0, 8 * kEps * max_abs_component(hit.point)) << i;
-        EXPECT_LT(length(hit.point - (start + d * *t)), 1e-9 * (*t + length(start))) << i;
+        EXPECT_LT(length(hit.point - (start + d * t->t)), 1e-9 * (t->t + length(start))) << i;
     }
 }
 
@@ -142,7 +142,7 @@ TEST(Plane, RayFromAPointOnThePlaneDoesNotRehit) {
             const auto again = plane.intersect({hit.point, out}, {0, kInfinity});
             if (again) {
                 ++rehits;
-                ADD_FAILURE() << "case " << k << " ray " << i << ": re-hit at t = " << *again;
+                ADD_FAILURE() << "case " << k << " ray " << i << ": re-hit at t = " << again->t;
                 if (rehits > 10) return;
             }
         }

@@ -166,8 +166,8 @@ TEST(Robustness, SpawnedRaysNeverReHitTheirSurfaceAtAnyMagnitude) {
                         // Across the chord of a direction at cosine `tilt` to the inward normal
                         // (shortened by the offset), to a point on the far side.
                         ASSERT_TRUE(through) << scale << " " << i;
-                        EXPECT_GT(*through, 0.99 * 2 * radius * tilt) << scale << " " << i;
-                        const Vec3 exit = spawn_ray(hit.point, n, in, 0).at(*through);
+                        EXPECT_GT(through->t, 0.99 * 2 * radius * tilt) << scale << " " << i;
+                        const Vec3 exit = spawn_ray(hit.point, n, in, 0).at(through->t);
                         EXPECT_NEAR(length(exit - centre), radius, 1e-12 * scale)
                             << scale << " " << i;
                     }

@@ -249,8 +249,8 @@ TEST(SceneLoader, ReadsTheContractExample) {
     ASSERT_EQ(s.objects.size(), 2u);
     expect_vec(plane(s, 0).normal(), 0, 1, 0);
     EXPECT_EQ(&plane(s, 0).material(), &m);
-    expect_vec(sphere(s, 1).path().at(0), 300, 100, 300);
-    EXPECT_EQ(sphere(s, 1).path().size(), 1u);
+    expect_vec(sphere(s, 1).path().points().at(0), 300, 100, 300);
+    EXPECT_EQ(sphere(s, 1).path().points().size(), 1u);
     EXPECT_DOUBLE_EQ(sphere(s, 1).radius(), 100);
     EXPECT_EQ(&sphere(s, 1).material(), &m);
 }
@@ -318,7 +318,7 @@ TEST(SceneLoader, WrappersAreOptionalAndDocumentOrderIsKept) {
     EXPECT_TRUE(s.lights[0]->is_point());
     EXPECT_FALSE(s.lights[1]->is_point());
     ASSERT_EQ(s.objects.size(), 3u);
-    expect_vec(sphere(s, 0).path()[0], 1, 0, 0);
+    expect_vec(sphere(s, 0).path().points()[0], 1, 0, 0);
     expect_vec(plane(s, 1).normal(), 0, 0, 1);
     expect_vec(plane(s, 2).normal(), 1, 0, 0);
 }
@@ -343,11 +343,11 @@ TEST(SceneLoader, MotionBlurPositionsFollowThePresentPositionInOrder) {
         </Sphere>)"))
                         .scene;
     const Sphere& sp = sphere(s, 0);
-    ASSERT_EQ(sp.path().size(), 4u);
-    expect_vec(sp.path()[0], 10, 20, 30);
-    expect_vec(sp.path()[1], 11, 20, 30);
-    expect_vec(sp.path()[2], 13, 21, 30);
-    expect_vec(sp.path()[3], 16, 22, 31);
+    ASSERT_EQ(sp.path().points().size(), 4u);
+    expect_vec(sp.path().points()[0], 10, 20, 30);
+    expect_vec(sp.path().points()[1], 11, 20, 30);
+    expect_vec(sp.path().points()[2], 13, 21, 30);
+    expect_vec(sp.path().points()[3], 16, 22, 31);
     EXPECT_DOUBLE_EQ(sp.motion_end(), 3);
     EXPECT_DOUBLE_EQ(s.shutter_end(), 3);
 }

@@ -179,7 +179,7 @@ TEST(TextureChecker, OnASphereIsRelativeToItsCentre) {
     // A moving sphere carries its texture along.
     const Sphere moving({{7, 0, 0}, {57, 0, 0}}, 10, material, detail);
     for (const double time : {0.0, 0.37, 1.0}) {
-        const Vec3 c = moving.centre_at(time);
+        const Vec3 c = moving.path().at(time);
         const Ray ray{c + Vec3{1.3, 30, 2.1}, {0, -1, 0}, time};
         const auto ti = moving.intersect(ray, {});
         ASSERT_TRUE(ti) << time;

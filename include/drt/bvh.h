@@ -1,12 +1,11 @@
-// A bounding-volume hierarchy over the scene's bounded objects, aware of motion: a moving
-// sphere enters once per segment of its path, bounded over that segment's time span only, and
-// every node knows the time span of what it holds, so rays skip objects that are elsewhere at
-// their time. Unbounded objects (planes) are tested separately.
+// A bounding-volume hierarchy over the scene's bounded shapes, aware of motion: a moving sphere
+// enters once per segment of its path, bounded over that segment's time span only, and every
+// node knows the time span of what it holds, so rays skip shapes that are elsewhere at their
+// time. Unbounded shapes (planes) are tested separately.
 //
-// Spheres and planes, which is all the scene format has, are copied into flat arrays and tested
-// inline with the same arithmetic as Sphere::intersect and Plane::intersect, so a traversal
-// makes no virtual call and chases no pointer; any other kind of object is asked through the
-// Object interface.
+// Objects hand over their geometry as typed shapes (Object::shapes), copied here into flat
+// arrays and tested inline by one leaf test (Bvh::hit) with the same arithmetic as the objects'
+// own intersect, so a traversal makes no virtual call and chases no pointer.
 #pragma once
 
 #include <array>
@@ -18,11 +17,6 @@
 #include "drt/object.h"
 
 namespace drt {
-
-struct Intersection {
-    double t;
-    const Object* object;
-};
 
 // What may block the segments from one origin to the points of one ball (a light) at one time:
 // the planes and primitives that meet the cone those segments fill. Bvh::gather_occluders finds
@@ -41,7 +35,7 @@ class Bvh {
   public:
     explicit Bvh(const std::vector<std::unique_ptr<Object>>& objects);
 
-    std::optional<Intersection> intersect(const Ray& ray, Interval range) const;
+    std::optional<Hit> intersect(const Ray& ray, Interval range) const;
     // Whether anything blocks the ray within range (any hit will do, so it stops at the first).
     bool occluded(const Ray& ray, Interval range) const;
     // The same for a ray from `origin` to a point of the ball the occluders were gathered for,
@@ -50,32 +44,25 @@ class Bvh {
     Occluders gather_occluders(const Vec3& origin, const Ball& target, double time) const;
 
     std::size_t node_count() const { return nodes_.size(); }
-    std::size_t depth() const;
 
   private:
-    enum class Kind : std::uint32_t { kStillSphere, kMovingSphere, kOther };
+    enum class Kind : std::uint32_t { kStillSphere, kMovingSphere };
 
-    // One sphere, one segment of a moving sphere's path, or another bounded object.
+    // One still sphere or one segment of a moving sphere's path, in leaf order.
     struct alignas(64) Primitive {
-        Vec3 centre;  // a still sphere's centre; a moving one's at the start of its segment
+        Vec3 centre;  // a still sphere's (a moving one's is motions_[motion].at(time))
         double radius;
-        Interval time;  // shutter times at which this piece is where the bounds say
-        const Object* object;
+        Interval time;         // shutter times at which this piece is where the bounds say
+        std::uint32_t object;  // index into objects_
+        std::uint32_t index;   // Hit::primitive: which of the object's shapes
         Kind kind;
         std::uint32_t motion;  // index into motions_ for a moving sphere
-    };
-    // Where a segment of a moving sphere's path goes: it starts at time `start` at the
-    // primitive's centre and ends one time unit later at `end`.
-    struct Motion {
-        Vec3 delta;  // end - centre
-        Vec3 end;
-        double start;
     };
     struct PlaneData {
         Vec3 point, normal;
         double point_scale;  // max_abs_component(point)
         double offset;       // dot(point, normal)
-        const Object* object;
+        std::uint32_t object, index;
     };
     // A node is one cache line: its box, the time span of what it holds (rounded outwards to
     // float), and its primitives (leaf) or its second child (inner; the first follows it).
@@ -95,16 +82,19 @@ class Bvh {
     std::uint32_t build(std::vector<Build>& items, std::uint32_t begin, std::uint32_t end,
                         int depth);
     template <bool kAnyHit>
-    std::optional<Intersection> traverse(const Ray& ray, Interval range,
-                                         const Occluders& occluders) const;
-    std::optional<double> hit_primitive(const Primitive& p, const Ray& ray, double origin_scale,
-                                        Interval range) const;
+    std::optional<Hit> traverse(const Ray& ray, Interval range, const Occluders& occluders) const;
+    // The one leaf test: the ray parameter inside `range` at which the ray meets primitive p at
+    // the ray's time. `uv` receives the primitive's own coordinates where its test yields them.
+    std::optional<double> hit(const Primitive& p, const Ray& ray, double origin_scale,
+                              Interval range, Vec2& uv) const;
+    // Where primitive p is at `time`, as a ball (for the shadow-ray culling).
+    Ball ball_at(const Primitive& p, double time) const;
 
+    std::vector<const Object*> objects_;
     std::vector<Primitive> primitives_;  // in leaf order
-    std::vector<Motion> motions_;
+    std::vector<PathSegment> motions_;
     std::vector<Node> nodes_;
     std::vector<PlaneData> planes_;
-    std::vector<const Object*> unbounded_;  // unbounded objects other than planes
 };
 
 }  // namespace drt

@@ -1,7 +1,10 @@
 // The abstract scene object: something a ray can hit, made of a material, optionally textured
-// and bump-mapped.
+// and bump-mapped. An object hands the BVH its geometry as typed shapes (spheres, planes), which
+// the BVH copies into flat arrays and tests inline; the object itself is asked again only about
+// the one hit a ray keeps, for its surface.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -9,10 +12,26 @@
 #include "drt/color.h"
 #include "drt/material.h"
 #include "drt/math.h"
+#include "drt/motion.h"
 #include "drt/ray.h"
 #include "drt/texture.h"
 
 namespace drt {
+
+class Object;
+
+// Where a ray met a primitive (pbrt-v4's and Mitsuba 3's preliminary intersection): what the
+// intersection test knows, from which Object::surface_at works out the rest for the one hit a
+// ray keeps.
+struct Hit {
+    double t = kInfinity;            // ray parameter
+    const Object* object = nullptr;  // the object hit
+    std::uint32_t primitive = 0;     // which of the object's shapes (a mesh's triangle number)
+    // The primitive's own coordinates of the hit where its test yields them (a triangle's
+    // barycentrics b1, b2, from which a mesh interpolates normals). Spheres and planes leave
+    // them 0: their surface follows exactly from the point ray.at(t) projected onto them.
+    Vec2 uv;
+};
 
 // What the integrator needs to know about the point a ray hit.
 struct SurfaceHit {
@@ -22,11 +41,22 @@ struct SurfaceHit {
     Color kd;             // diffuse colour after texturing
 };
 
-// Bounds of an object over a span of shutter time; a moving object has one per path segment,
-// so a BVH can skip it at times it is elsewhere.
-struct TimedBounds {
-    Bounds bounds;
-    Interval time{-kInfinity, kInfinity};
+// A sphere as the BVH stores it: the BVH splits its path into one piece per segment, each bounded
+// over that segment's time span only.
+struct SphereShape {
+    const MotionPath* path;  // owned by the object, which outlives the BVH
+    double radius;
+};
+struct PlaneShape {
+    Vec3 point, normal;  // normal of unit length
+};
+// An object's geometry in the typed forms the BVH tests inline (no virtual call and no pointer
+// chase per ray). A new kind of primitive gets its array here, its Kind and case in the BVH's
+// one leaf test (Bvh::hit) and its bounds in the BVH's build; Hit::primitive is its index in
+// its array.
+struct Shapes {
+    std::vector<SphereShape> spheres;
+    std::vector<PlaneShape> planes;  // unbounded: tested outside the tree
 };
 
 // How an object's surface departs from its material's plain colour.
@@ -43,10 +73,10 @@ class Object {
     Object(const Object&) = delete;
     Object& operator=(const Object&) = delete;
 
-    // Ray parameter of the nearest intersection inside `range`, if any.
-    virtual std::optional<double> intersect(const Ray& ray, Interval range) const = 0;
-    // Bounding boxes over time; empty for an unbounded object (a plane).
-    virtual std::vector<TimedBounds> motion_bounds() const = 0;
+    // The nearest intersection inside `range`, if any, tested on this object alone (the BVH
+    // tests the same shapes with the same arithmetic and must find the same hit).
+    virtual std::optional<Hit> intersect(const Ray& ray, Interval range) const = 0;
+    virtual Shapes shapes() const = 0;
 
     const Material& material() const { return *material_; }
     const SurfaceDetail& detail() const { return detail_; }
@@ -54,17 +84,23 @@ class Object {
     virtual double motion_end() const { return 0; }
     bool moves() const { return motion_end() > 0; }
 
-    // Surface information at ray.at(t), where t came from intersect().
-    SurfaceHit surface_at(const Ray& ray, double t) const;
+    // Surface information at a hit on this object by `ray`.
+    SurfaceHit surface_at(const Ray& ray, const Hit& hit) const;
 
   protected:
-    // The exact point on the surface nearest to `p`, which removes most of the rounding error
-    // a hit point picks up from ray.at(t).
-    virtual Vec3 project_to_surface(const Vec3& p, double time) const = 0;
-    virtual Vec3 outward_normal(const Vec3& point, double time) const = 0;
-    // Coordinates a texture is evaluated in, and world-aligned coordinates for bump noise.
-    virtual Vec3 texture_point(const Vec3& point, double time) const = 0;
-    virtual Vec3 bump_point(const Vec3& point, double time) const = 0;
+    // Where on the surface a hit lies, before texture and bump.
+    struct SurfacePoint {
+        // The exact point on the surface nearest to ray.at(t), which removes most of the
+        // rounding error a hit point picks up.
+        Vec3 point;
+        Vec3 normal;  // geometric, unit, outward
+        // Before bump mapping: the geometric normal, or one a mesh interpolates over a triangle.
+        Vec3 shading_normal;
+        // Coordinates a texture is evaluated in (fixed to a moving object), and world-aligned
+        // ones for bump noise.
+        Vec3 texture_point, bump_point;
+    };
+    virtual SurfacePoint locate(const Ray& ray, const Hit& hit) const = 0;
 
   private:
     const Material* material_;

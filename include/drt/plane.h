@@ -33,19 +33,16 @@ class Plane final : public Object {
   public:
     Plane(Vec3 point, Vec3 normal, const Material& material, SurfaceDetail detail = {});
 
-    std::optional<double> intersect(const Ray& ray, Interval range) const override;
-    std::vector<TimedBounds> motion_bounds() const override { return {}; }
+    std::optional<Hit> intersect(const Ray& ray, Interval range) const override;
+    Shapes shapes() const override { return {{}, {PlaneShape{point_, frame_.n}}}; }
 
     const Vec3& normal() const { return frame_.n; }
     const Vec3& point() const { return point_; }
 
   protected:
-    Vec3 project_to_surface(const Vec3& p, double time) const override;
-    Vec3 outward_normal(const Vec3&, double) const override { return frame_.n; }
-    // The plane's own 2-D coordinates (about the world origin's projection), so a checker on a
-    // plane through the origin has a cell corner there.
-    Vec3 texture_point(const Vec3& point, double time) const override;
-    Vec3 bump_point(const Vec3& point, double) const override { return point; }
+    // Textures are evaluated in the plane's own 2-D coordinates (about the world origin's
+    // projection), so a checker on a plane through the origin has a cell corner there.
+    SurfacePoint locate(const Ray& ray, const Hit& hit) const override;
 
   private:
     Vec3 point_;

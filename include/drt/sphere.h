@@ -9,29 +9,25 @@
 
 namespace drt {
 
-// A sphere, optionally moving along a polyline: path[0] is its position at time 0 (the
-// present), path[k] at time k (the past), linear in between, resting at the last position after.
+// A sphere, optionally moving along a path (MotionPath: path[0] is its position at time 0, the
+// present, path[k] at time k, the past).
 class Sphere final : public Object {
   public:
     Sphere(std::vector<Vec3> path, double radius, const Material& material,
            SurfaceDetail detail = {});
 
-    std::optional<double> intersect(const Ray& ray, Interval range) const override;
-    std::vector<TimedBounds> motion_bounds() const override;
-    double motion_end() const override { return static_cast<double>(path_.size() - 1); }
+    std::optional<Hit> intersect(const Ray& ray, Interval range) const override;
+    Shapes shapes() const override { return {{SphereShape{&path_, radius_}}, {}}; }
+    double motion_end() const override { return path_.end(); }
 
-    Vec3 centre_at(double time) const;
     double radius() const { return radius_; }
-    const std::vector<Vec3>& path() const { return path_; }
+    const MotionPath& path() const { return path_; }
 
   protected:
-    Vec3 project_to_surface(const Vec3& p, double time) const override;
-    Vec3 outward_normal(const Vec3& point, double time) const override;
-    Vec3 texture_point(const Vec3& point, double time) const override;
-    Vec3 bump_point(const Vec3& point, double time) const override;
+    SurfacePoint locate(const Ray& ray, const Hit& hit) const override;
 
   private:
-    std::vector<Vec3> path_;
+    MotionPath path_;
     double radius_;
 };
 
