@@ -209,43 +209,50 @@ std::uint32_t Bvh::build(std::vector<Build>& items, std::uint32_t begin, std::ui
     return index;
 }
 
-std::optional<double> Bvh::hit(const Primitive& p, const Ray& ray, double origin_scale,
-                               Interval range, Vec2& /*uv*/) const {
-    // Still spheres, the common case, first.
+// Still spheres, the common case, inline; a moving sphere's segment out of line.
+inline std::optional<double> Bvh::hit(const Primitive& p, const Ray& ray, double origin_scale,
+                                      Interval range, Vec2& /*uv*/) const {
     if (p.kind == Kind::kStillSphere) {
         return intersect_sphere(p.centre, p.radius, ray, origin_scale, range);
     }
+    return hit_segment(p, ray, origin_scale, range);
+}
+
+std::optional<double> Bvh::hit_segment(const Primitive& p, const Ray& ray, double origin_scale,
+                                       Interval range) const {
     if (!p.time.contains(ray.time)) return std::nullopt;
     return intersect_sphere(motions_[p.motion].at(ray.time), p.radius, ray, origin_scale, range);
 }
 
-Ball Bvh::ball_at(const Primitive& p, double time) const {
-    return {p.kind == Kind::kStillSphere ? p.centre : motions_[p.motion].at(time), p.radius};
+inline Ball Bvh::ball_at(const Primitive& p, double time) const {
+    if (p.kind == Kind::kStillSphere) return {p.centre, p.radius};
+    return {motions_[p.motion].at(time), p.radius};
 }
 
 template <bool kAnyHit>
-std::optional<Hit> Bvh::traverse(const Ray& ray, Interval range, const Occluders& occluders) const {
+bool Bvh::traverse(const Ray& ray, Interval& range, const Occluders& occluders,
+                   Nearest& nearest) const {
     const double origin_scale = max_abs_component(ray.origin);
-    std::optional<Hit> nearest;
+    bool found = false;
     for (std::size_t i = 0; i < planes_.size(); ++i) {
         if (i < 64 && (occluders.planes >> i & 1) == 0) continue;
         const PlaneData& plane = planes_[i];
         if (auto t = intersect_plane(plane.point, plane.normal, plane.point_scale, ray,
                                      origin_scale, range)) {
-            nearest = Hit{*t, objects_[plane.object], plane.index, {}};
-            if constexpr (kAnyHit) return nearest;
+            if constexpr (kAnyHit) return true;
+            found = true, nearest = {plane.object, plane.index, {}};
             range.max = *t;
         }
     }
-    if (nodes_.empty()) return nearest;
+    if (nodes_.empty()) return found;
     // Tests a leaf's primitives; true when an any-hit query is answered.
+    Vec2 uv;  // written only by primitives whose test yields coordinates
     auto leaf = [&](const Node& node) {
         for (std::uint32_t i = node.offset; i < node.offset + node.count; ++i) {
             const Primitive& p = primitives_[i];
-            Vec2 uv;
             if (auto t = hit(p, ray, origin_scale, range, uv)) {
-                nearest = Hit{*t, objects_[p.object], p.index, uv};
                 if constexpr (kAnyHit) return true;
+                found = true, nearest = {p.object, p.index, uv};
                 range.max = *t;
             }
         }
@@ -253,13 +260,12 @@ std::optional<Hit> Bvh::traverse(const Ray& ray, Interval range, const Occluders
     };
     // A few primitives in all (a tree that is one leaf): testing them is cheaper than their box.
     if (nodes_[0].count > 0) {
-        leaf(nodes_[0]);
-        return nearest;
+        return leaf(nodes_[0]) || found;
     }
 
     const RayData r(ray);
     double entry = 0;
-    if (!r.enters(nodes_[0], range.min, range.max, entry)) return nearest;
+    if (!r.enters(nodes_[0], range.min, range.max, entry)) return found;
     struct Pending {
         std::uint32_t node;
         double entry;
@@ -287,11 +293,11 @@ std::optional<Hit> Bvh::traverse(const Ray& ray, Interval range, const Occluders
                 continue;
             }
         } else if (leaf(node)) {
-            return nearest;
+            return true;  // an any-hit query answered
         }
         // Next pending node the ray still reaches before the nearest hit so far.
         do {
-            if (top == 0) return nearest;
+            if (top == 0) return found;
             --top;
         } while (stack[top].entry > range.max);
         current = stack[top].node;
@@ -299,16 +305,22 @@ std::optional<Hit> Bvh::traverse(const Ray& ray, Interval range, const Occluders
 }
 
 std::optional<Hit> Bvh::intersect(const Ray& ray, Interval range) const {
-    return traverse<false>(ray, range, Occluders{});
+    Nearest nearest;
+    if (!traverse<false>(ray, range, Occluders{}, nearest)) return std::nullopt;
+    return Hit{range.max, objects_[nearest.object], nearest.index, nearest.uv};
 }
 
 bool Bvh::occluded(const Ray& ray, Interval range) const {
-    return traverse<true>(ray, range, Occluders{}).has_value();
+    Nearest unused;
+    return traverse<true>(ray, range, Occluders{}, unused);
 }
 
 bool Bvh::occluded(const Ray& ray, Interval range, const Occluders& occluders) const {
     if (occluders.nothing) return false;
-    if (occluders.everything) return traverse<true>(ray, range, occluders).has_value();
+    if (occluders.everything) {
+        Nearest unused;
+        return traverse<true>(ray, range, occluders, unused);
+    }
     // Only what was gathered: the planes whose bits are set and the listed primitives.
     const double origin_scale = max_abs_component(ray.origin);
     for (std::uint64_t left = occluders.planes; left != 0; left &= left - 1) {

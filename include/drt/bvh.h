@@ -81,12 +81,22 @@ class Bvh {
 
     std::uint32_t build(std::vector<Build>& items, std::uint32_t begin, std::uint32_t end,
                         int depth);
+    // What a traversal keeps of the nearest hit so far (its t is the range's end).
+    struct Nearest {
+        std::uint32_t object = 0, index = 0;
+        Vec2 uv;
+    };
+    // Whether the ray hits anything within range; the nearest hit (or, for kAnyHit, the first
+    // found) shrinks range.max to its t and is described in `nearest`.
     template <bool kAnyHit>
-    std::optional<Hit> traverse(const Ray& ray, Interval range, const Occluders& occluders) const;
+    bool traverse(const Ray& ray, Interval& range, const Occluders& occluders,
+                  Nearest& nearest) const;
     // The one leaf test: the ray parameter inside `range` at which the ray meets primitive p at
     // the ray's time. `uv` receives the primitive's own coordinates where its test yields them.
     std::optional<double> hit(const Primitive& p, const Ray& ray, double origin_scale,
                               Interval range, Vec2& uv) const;
+    std::optional<double> hit_segment(const Primitive& p, const Ray& ray, double origin_scale,
+                                      Interval range) const;
     // Where primitive p is at `time`, as a ball (for the shadow-ray culling).
     Ball ball_at(const Primitive& p, double time) const;
 
