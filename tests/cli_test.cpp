@@ -497,11 +497,17 @@ TEST_F(CliTest, StatsJsonHasEveryContractKeyAndRaysAddUp) {
     EXPECT_GT(rays["shadow"].number(), 0);
     EXPECT_GT(rays["reflection"].number(), 0);
     EXPECT_GT(rays["refraction"].number(), 0);
-    if (rays.has("total")) {
-        EXPECT_EQ(rays["total"].number(), rays["camera"].number() + rays["shadow"].number() +
-                                              rays["reflection"].number() +
-                                              rays["refraction"].number());
-    }
+    // drt's own keys besides the contract's: the total and the settings the render used.
+    EXPECT_EQ(rays["total"].number(), rays["camera"].number() + rays["shadow"].number() +
+                                          rays["reflection"].number() +
+                                          rays["refraction"].number());
+    EXPECT_EQ(j["shadow_rays"].number(), 2);
+    EXPECT_EQ(j["glossy_rays"].number(), 1);
+    EXPECT_EQ(j["max_depth"].number(), 8);
+    EXPECT_EQ(j["seed"].number(), 3);
+    EXPECT_EQ(std::get<std::string>(j["sampler"].value), "stratified");
+    EXPECT_EQ(j["mean_spp"].number(), 3);
+    EXPECT_GE(j["million_rays_per_second"].number(), 0);
     const Json& effects = j["effects"];
     EXPECT_TRUE(effects["antialiasing"].boolean());
     EXPECT_TRUE(effects["soft_shadows"].boolean());

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <utility>
 
 #include "drt/rng.h"
 #include "drt/sphere.h"
@@ -72,16 +73,48 @@ TEST(TexturePerlinNoise, IsContinuousIncludingAcrossCellFacesAndTheWrap) {
     }
 }
 
-TEST(TexturePerlinNoise, IsDeterministicAndPeriodic) {
+TEST(TexturePerlinNoise, IsPeriodic) {
     for (int i = 0; i < 100; ++i) {
         const Vec3 p = random_point(5, i, 100);
-        EXPECT_EQ(perlin_noise(p), perlin_noise(p));
         // The lattice hash repeats every 256 cells.
         EXPECT_NEAR(perlin_noise(p + Vec3{256, 0, 0}), perlin_noise(p), 1e-9);
         EXPECT_NEAR(perlin_noise(p - Vec3{0, 512, 0}), perlin_noise(p), 1e-9);
     }
     // Not the same value everywhere in a cell.
     EXPECT_NE(perlin_noise({0.5, 0.5, 0.5}), perlin_noise({0.3, 0.6, 0.2}));
+}
+
+// The gradient of the noise by central differences of step h (error O(h^2)).
+Vec3 noise_gradient(const Vec3& p, double h = 1e-6) {
+    return Vec3{perlin_noise(p + Vec3{h, 0, 0}) - perlin_noise(p - Vec3{h, 0, 0}),
+                perlin_noise(p + Vec3{0, h, 0}) - perlin_noise(p - Vec3{0, h, 0}),
+                perlin_noise(p + Vec3{0, 0, h}) - perlin_noise(p - Vec3{0, 0, h})} /
+           (2 * h);
+}
+
+// Whether v is, to tol, one of the 12 lattice gradients: two components +-1, the third 0.
+bool is_cube_edge_direction(const Vec3& v, double tol) {
+    int ones = 0, zeros = 0;
+    for (const double c : {v.x, v.y, v.z}) {
+        ones += std::abs(std::abs(c) - 1) < tol;
+        zeros += std::abs(c) < tol;
+    }
+    return ones == 2 && zeros == 1;
+}
+
+TEST(TexturePerlinNoise, GradientAtALatticePointIsOneOfTheTwelveCubeEdgeDirections) {
+    // At a lattice point the fade curves have zero slope, so only that corner's gradient
+    // counts: the noise's gradient there is the lattice gradient itself.
+    int seen_x0 = 0, seen_z0 = 0;
+    for (int i = 0; i < 200; ++i) {
+        const Vec3 p{std::floor(random_point(15, i, 300).x), std::floor(random_point(16, i, 300).y),
+                     std::floor(random_point(17, i, 300).z)};
+        const Vec3 g = noise_gradient(p);
+        EXPECT_TRUE(is_cube_edge_direction(g, 1e-6)) << g.x << " " << g.y << " " << g.z;
+        seen_x0 += std::abs(g.x) < 0.5, seen_z0 += std::abs(g.z) < 0.5;
+    }
+    EXPECT_GT(seen_x0, 20);  // the hash picks among them
+    EXPECT_GT(seen_z0, 20);
 }
 
 TEST(TextureTurbulence, IsNonNegativeAndBounded) {
@@ -134,6 +167,27 @@ TEST(TextureBumpMap, TiltFollowsTheNoiseGradient) {
         const Vec3 out = bump.perturb({0, 0, 1}, p);
         if (std::abs(gx) < 0.05) continue;
         EXPECT_LT(out.x * gx, 0) << i;
+    }
+}
+
+TEST(TextureBumpMap, TiltAtALatticePointIsTheStrengthAlongTheLatticeGradient) {
+    // At local = scale k (k on the integer lattice) the noise's gradient is a cube-edge
+    // direction g; the normal of a surface facing +z leans to normalize((-s g.x, -s g.y, 1)),
+    // s the strength, so its slopes -out.x/out.z and -out.y/out.z are each 0 or +-s. A 2 %
+    // error in the strength moves a slope by 0.02 s; one in the scale samples the noise off the
+    // lattice, where the slopes are anything. (The bump map's own difference step leaves
+    // about 1e-5.)
+    for (const auto& [scale, strength] : {std::pair{20.0, 0.3}, std::pair{3.5, 1.7}}) {
+        const BumpMap bump{scale, strength};
+        for (int i = 0; i < 100; ++i) {
+            const Vec3 k{std::floor(random_point(18, i, 100).x),
+                         std::floor(random_point(19, i, 100).y), 0};
+            const Vec3 out = bump.perturb({0, 0, 1}, k * scale);
+            const Vec3 g = noise_gradient(k);
+            EXPECT_NEAR(-out.x / out.z, strength * g.x, 1e-4 * strength) << i;
+            EXPECT_NEAR(-out.y / out.z, strength * g.y, 1e-4 * strength) << i;
+            EXPECT_TRUE(is_cube_edge_direction(g, 1e-6));
+        }
     }
 }
 
@@ -205,6 +259,23 @@ TEST(TextureMarble, StaysBetweenItsTwoColours) {
         near_a |= w<0.05, near_b |= w> 0.95;
     }
     EXPECT_TRUE(near_a && near_b);
+}
+
+TEST(TextureMarble, OnTheScaledLatticeIsTheBareSineWave) {
+    // Turbulence vanishes where every octave lands on the lattice, so at local = scale (i, j, k)
+    // the veins are undisturbed: the blend weight is 1/2 + sin(i)/2. A scale 2 % off samples
+    // the turbulence off the lattice and the sine at 0.98 i.
+    const Color a{0.9, 0.8, 0.7}, b{0.1, 0.2, 0.3};
+    for (const double scale : {50.0, 7.25}) {
+        const MarbleTexture marble(a, b, scale);
+        for (int i = -20; i <= 20; i += 3) {
+            const Vec3 lattice{double(i), double(i % 7), double(-2 * i)};
+            const double w = 0.5 + 0.5 * std::sin(double(i));
+            const Color c = marble.value(lattice * scale);
+            EXPECT_NEAR(c.r, a.r + w * (b.r - a.r), 1e-12) << scale << " " << i;
+            EXPECT_NEAR(c.b, a.b + w * (b.b - a.b), 1e-12) << scale << " " << i;
+        }
+    }
 }
 
 TEST(TextureFactory, MakesKnownTexturesAndRejectsUnknownNames) {
