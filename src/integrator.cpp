@@ -17,6 +17,10 @@ namespace {
 // fallback is taken with probability about 2^-32.
 constexpr int kRedrawAttempts = 32;
 
+// The point of the unit square that Light::sample maps to the light's centre as seen from outside
+// (cos θ = 1 in the cone): a light whose area is not sampled acts as a point there.
+constexpr Vec2 kLightCentre{0, 0};
+
 // The mirror direction about the shading normal, or about the geometric one when a bump has
 // tilted the shading normal so far that the mirror direction would dive below the surface (as
 // refraction falls back below), so an ideal reflection too leaves on the viewer's side.
@@ -107,32 +111,38 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
     }
     if (depth >= scene_.settings.max_depth) return result;  // deeper rays would contribute black
 
-    const double sigma = m.sigma();
+    // The plan says whether directions are perturbed at all, the material by how much.
+    const Effects& e = plan_.effects;
     if (m.reflects()) {
+        const double reflection_sigma = e.glossy_reflection ? m.sigma() : 0.0;
         const Vec3 ideal = reflect_above(ray.dir, shading, geometric);
         result += m.reflective * m.ks *
-                  scattered(surface.point, geometric, ideal, sigma, +1, ray.time, s, depth,
-                            dim::kGlossReflect, false, work);
+                  scattered(surface.point, geometric, ideal, reflection_sigma, +1, ray.time, s,
+                            depth, dim::kGlossReflect, false, work);
     }
     if (m.transmits()) {
+        const double sigma = m.sigma();
+        const double reflection_sigma = e.glossy_reflection ? sigma : 0.0;
+        const double refraction_sigma = e.glossy_refraction ? sigma : 0.0;
         // The medium outside every object is air (index 1), as in the thesis.
         const double eta = outside ? 1.0 / m.index : m.index;
         const double cos_i = std::max(0.0, -dot(ray.dir, shading));
         const double fresnel = fresnel_dielectric(cos_i, eta);
         Color glass;
         if (fresnel > 0) {
-            glass += fresnel * scattered(surface.point, geometric,
-                                         reflect_above(ray.dir, shading, geometric), sigma, +1,
-                                         ray.time, s, depth, dim::kGlassReflect, false, work);
+            glass +=
+                fresnel * scattered(surface.point, geometric,
+                                    reflect_above(ray.dir, shading, geometric), reflection_sigma,
+                                    +1, ray.time, s, depth, dim::kGlassReflect, false, work);
         }
         if (fresnel < 1) {
             auto through = refract(ray.dir, shading, eta);
             if (!through || dot(*through, geometric) >= 0)
                 through = refract(ray.dir, geometric, eta);
             if (through) {
-                glass +=
-                    (1.0 - fresnel) * scattered(surface.point, geometric, *through, sigma, -1,
-                                                ray.time, s, depth, dim::kGlossRefract, true, work);
+                glass += (1.0 - fresnel) * scattered(surface.point, geometric, *through,
+                                                     refraction_sigma, -1, ray.time, s, depth,
+                                                     dim::kGlossRefract, true, work);
             }
         }
         result += m.transmit * m.kt * glass;
@@ -203,7 +213,9 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
         Color light_sum;
         for (int first = 0; first < rays; first += kChunk) {
             const auto n = static_cast<std::size_t>(std::min(kChunk, rays - first));
-            if (rays == 1) {
+            if (!plan_.effects.soft_shadows) {
+                std::fill_n(points.begin(), n, kLightCentre);
+            } else if (rays == 1) {
                 points[0] = sampler_.get_2d(s, dimension);
             } else {
                 sampler_.get_2d_set(s, dimension, static_cast<std::uint32_t>(rays),
@@ -244,6 +256,7 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
             const double p = cdf[k] - lo;
             u.x =
                 std::clamp((u.x - lo) / p, 0.0, std::nextafter(1.0, 0.0));  // reuse within the pick
+            if (!plan_.effects.soft_shadows) u = kLightCentre;
             const Light& light = *area_lights_[k];
             sum += light_ray(light, light.sample(point, u), origin, geometric, shading, time,
                              Occluders{}, counts) /

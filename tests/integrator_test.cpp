@@ -2,12 +2,20 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
+#include "drt/render_plan.h"
 #include "drt/renderer.h"
+#include "drt/sampler.h"
 #include "test_scenes.h"
 
 namespace drt {
@@ -303,6 +311,140 @@ TEST(PerturbDirection, AngularSpreadMatchesSigma) {
     }
     // The angle of a 2-D normal offset with per-axis deviation sigma has E[angle^2] = 2 sigma^2.
     EXPECT_NEAR(sum_sq / n, 2 * sigma * sigma, 0.02 * 2 * sigma * sigma);
+}
+
+// Integrator runs with a plan whose effect flags may be changed from what plan_render decides.
+class PlannedIntegrator {
+  public:
+    PlannedIntegrator(const Scene& scene, const std::function<void(Effects&)>& change)
+        : scene_(scene),
+          plan_(plan_render(scene)),
+          bvh_(scene.objects),
+          sampler_(make_sampler(scene.settings.sampler)) {
+        change(plan_.effects);
+        integrator_.emplace(scene, plan_, bvh_, *sampler_);
+    }
+    // Every camera sample of pixel (x, y).
+    std::vector<Color> pixel(int x, int y, RayCounts& rays) const {
+        const auto spp = static_cast<std::uint32_t>(scene_.settings.samples);
+        std::vector<Color> colors(spp);
+        const PixelSample s{scene_.settings.seed,
+                            static_cast<std::uint32_t>(y * scene_.settings.width + x), 0, spp};
+        integrator_->sample_pixel(x, y, s, colors, rays);
+        return colors;
+    }
+    // Whether any pixel's camera samples differ from one another.
+    bool samples_vary() const {
+        RayCounts rays;
+        for (int y = 0; y < scene_.settings.height; ++y) {
+            for (int x = 0; x < scene_.settings.width; ++x) {
+                const std::vector<Color> c = pixel(x, y, rays);
+                if (std::any_of(c.begin(), c.end(), [&](const Color& v) { return v != c[0]; }))
+                    return true;
+            }
+        }
+        return false;
+    }
+
+  private:
+    const Scene& scene_;
+    RenderPlan plan_;
+    Bvh bvh_;
+    std::unique_ptr<Sampler> sampler_;
+    std::optional<Integrator> integrator_;
+};
+
+// Each figure scene calls for antialiasing and one or two other effects. With antialiasing and
+// those effects turned off in the plan, a pixel's samples are all the same; with one of them
+// left on, they are not. So each flag is read, and nothing is sampled behind a flag's back.
+TEST(Integrator, SamplesEveryEffectItsPlanCallsForAndNoOther) {
+    struct Case {
+        std::string scene;
+        std::function<void(Effects&)> off;  // besides antialiasing
+        bool samples_vary;
+    };
+    const auto nothing = [](Effects&) {};
+    const std::vector<Case> cases = {
+        {"figures/aa-10spp.xml", nothing, false},
+        {"figures/depth-of-field.xml", nothing, true},
+        {"figures/depth-of-field.xml", [](Effects& e) { e.depth_of_field = false; }, false},
+        {"figures/motion-blur.xml", nothing, true},
+        {"figures/motion-blur.xml", [](Effects& e) { e.motion_blur = false; }, false},
+        {"figures/soft-shadow-one-light.xml", nothing, true},
+        {"figures/soft-shadow-one-light.xml", [](Effects& e) { e.soft_shadows = false; }, false},
+        {"figures/glossy-n10.xml", nothing, true},
+        {"figures/glossy-n10.xml", [](Effects& e) { e.glossy_reflection = false; }, false},
+        {"figures/refraction-n10.xml", [](Effects& e) { e.glossy_reflection = false; }, true},
+        {"figures/refraction-n10.xml", [](Effects& e) { e.glossy_refraction = false; }, true},
+        {"figures/refraction-n10.xml",
+         [](Effects& e) { e.glossy_reflection = e.glossy_refraction = false; }, false},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.scene);
+        const Scene scene = testing::scaled_scene(c.scene, 24, 8);
+        EXPECT_TRUE(PlannedIntegrator(scene, nothing).samples_vary());
+        const PlannedIntegrator reduced(scene, [&](Effects& e) {
+            e.antialiasing = false;
+            c.off(e);
+        });
+        EXPECT_EQ(reduced.samples_vary(), c.samples_vary);
+    }
+}
+
+// Glossy rays are traced as the plan says: GlossyRays at the first hit when the effect is on,
+// exactly one ideal ray per hit when it is off, whatever the material's sharpness.
+TEST(Integrator, GlossyRaysFollowThePlansFlags) {
+    const auto glossy_rays = [](const Material& material,
+                                const std::function<void(Effects&)>& change) {
+        Scene scene = testing::lone_sphere_scene(material, {0.2, 0.4, 0.6});
+        scene.settings.samples = 4;
+        scene.settings.glossy_rays = 8;
+        scene.settings.max_depth = 1;  // no second bounce inside the glass
+        RayCounts rays;
+        PlannedIntegrator(scene, change).pixel(16, 16, rays);  // the sphere's middle
+        EXPECT_EQ(rays.camera, 4u);
+        return std::pair{rays.reflection, rays.refraction};
+    };
+    const auto as_planned = [](Effects&) {};
+    const auto no_glossy_reflection = [](Effects& e) { e.glossy_reflection = false; };
+    const auto no_glossy_refraction = [](Effects& e) { e.glossy_refraction = false; };
+    const Material mirror = testing::mirror({0.9, 0.9, 0.9}, 10);
+    EXPECT_EQ(glossy_rays(mirror, as_planned), std::pair(32ul, 0ul));
+    EXPECT_EQ(glossy_rays(mirror, no_glossy_reflection), std::pair(4ul, 0ul));
+    const Material glass = testing::glass(1.5, 10);
+    EXPECT_EQ(glossy_rays(glass, as_planned), std::pair(32ul, 32ul));
+    EXPECT_EQ(glossy_rays(glass, no_glossy_reflection), std::pair(4ul, 32ul));
+    EXPECT_EQ(glossy_rays(glass, no_glossy_refraction), std::pair(32ul, 4ul));
+
+    // Off, the one ray is the ideal one: the same radiance as an ideal mirror's.
+    Scene glossy = testing::lone_sphere_scene(mirror, {0.2, 0.4, 0.6});
+    Scene ideal = testing::lone_sphere_scene(testing::mirror({0.9, 0.9, 0.9}), {0.2, 0.4, 0.6});
+    RayCounts rays;
+    EXPECT_EQ(PlannedIntegrator(glossy, no_glossy_reflection).pixel(12, 13, rays),
+              PlannedIntegrator(ideal, as_planned).pixel(12, 13, rays));
+}
+
+// A sphere light whose area is not sampled shines as a point light at its centre.
+TEST(Integrator, SoftShadowsOffLightsFromTheLightsCentre) {
+    const Scene area = testing::scaled_scene("figures/soft-shadow-one-light.xml", 24, 1);
+    Scene point = testing::scaled_scene("figures/soft-shadow-one-light.xml", 24, 1);
+    const Ball ball = point.lights[0]->extent();
+    point.lights[0] = std::make_unique<PointLight>(ball.centre, point.lights[0]->intensity());
+    const PlannedIntegrator area_as_point(area, [](Effects& e) { e.soft_shadows = false; });
+    const PlannedIntegrator point_light(point, [](Effects&) {});
+    const PlannedIntegrator soft(area, [](Effects&) {});
+    int differ_when_soft = 0;
+    for (int y = 0; y < area.settings.height; ++y) {
+        for (int x = 0; x < area.settings.width; ++x) {
+            RayCounts rays;
+            const Color got = area_as_point.pixel(x, y, rays)[0];
+            const Color want = point_light.pixel(x, y, rays)[0];
+            ASSERT_NEAR(got.r, want.r, 1e-12) << x << "," << y;
+            ASSERT_NEAR(got.b, want.b, 1e-12) << x << "," << y;
+            differ_when_soft += std::abs(soft.pixel(x, y, rays)[0].r - want.r) > 1e-3;
+        }
+    }
+    EXPECT_GT(differ_when_soft, 10);
 }
 
 }  // namespace

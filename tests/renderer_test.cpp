@@ -6,9 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cmath>
 #include <cstring>
-#include <filesystem>
 #include <mutex>
 #include <new>
 #include <random>
@@ -17,23 +15,14 @@
 #include <string>
 #include <vector>
 
-#include "drt/scene_loader.h"
 #include "drt/tile.h"
 #include "test_scenes.h"
 
 namespace drt {
 namespace {
 
-// A scene of scenes/ at `width` pixels across (framed as drt --scale frames it), 4 samples.
 Scene small_scene(const std::string& name, int width) {
-    Scene scene = load_scene(std::filesystem::path(DRT_SOURCE_DIR) / "scenes" / name).scene;
-    RenderSettings& s = scene.settings;
-    const double scale = double(width) / s.width;
-    s.width = width;
-    s.height = static_cast<int>(std::lround(s.height * scale));
-    s.pixel_plane_unit /= scale;
-    s.samples = 4;
-    return scene;
+    return testing::scaled_scene(name, width, 4);
 }
 
 RenderOptions on_threads(int threads) {

@@ -1,10 +1,14 @@
 // Small scenes built in code, for tests that must not depend on the loader.
 #pragma once
 
+#include <cmath>
+#include <filesystem>
 #include <memory>
+#include <string>
 
 #include "drt/plane.h"
 #include "drt/scene.h"
+#include "drt/scene_loader.h"
 #include "drt/sphere.h"
 
 namespace drt::testing {
@@ -65,6 +69,19 @@ inline Scene lone_sphere_scene(Material material, Color background, int size = 3
     scene.view = LookAt{{0, 0, -10}, {0, 0, 0}, {0, 1, 0}, 20};
     const Material& m = add_material(scene, std::move(material));
     scene.objects.push_back(std::make_unique<Sphere>(std::vector<Vec3>{{0, 0, 0}}, 1.5, m));
+    return scene;
+}
+
+// A scene of scenes/ (`name` relative to it) at `width` pixels across, framed as drt --scale
+// frames it, with `samples` camera samples per pixel.
+inline Scene scaled_scene(const std::string& name, int width, int samples) {
+    Scene scene = load_scene(std::filesystem::path(DRT_SOURCE_DIR) / "scenes" / name).scene;
+    RenderSettings& s = scene.settings;
+    const double scale = double(width) / s.width;
+    s.width = width;
+    s.height = static_cast<int>(std::lround(s.height * scale));
+    s.pixel_plane_unit /= scale;
+    s.samples = samples;
     return scene;
 }
 

@@ -10,6 +10,8 @@
 
 namespace drt {
 
+// Whether each effect is sampled. The integrator reads these and nothing else to decide; how
+// much (σ, lens radius, shutter, shadow rays) still comes from the scene and the plan below.
 struct Effects {
     bool antialiasing = false;       // more than one camera ray per pixel
     bool soft_shadows = false;       // an area light and a diffuse surface to cast its penumbra on
