@@ -14,6 +14,7 @@
 
 #include "drt/integrator.h"
 #include "drt/light.h"
+#include "drt/multi_jittered.h"
 #include "drt/plane.h"
 #include "drt/rng.h"
 #include "drt/sampler.h"

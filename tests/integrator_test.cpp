@@ -1,4 +1,5 @@
 #include "drt/integrator.h"
+#include "drt/multi_jittered.h"
 
 #include <gtest/gtest.h>
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "drt/rng.h"
+#include "drt/multi_jittered.h"
 #include "drt/sampler.h"
 #include "test_math.h"
 

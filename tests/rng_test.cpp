@@ -12,7 +12,7 @@
 namespace drt {
 namespace {
 
-static_assert(to_unit(0) == 0.0);
+static_assert(to_unit(std::uint64_t{0}) == 0.0);
 static_assert(permute(0, 1, 1234) == 0);
 static_assert(mix64(1) != 1);
 
@@ -40,13 +40,13 @@ constexpr std::uint64_t unmix64(std::uint64_t z) {
 }
 
 TEST(Rng, ToUnitCoversTheHalfOpenUnitInterval) {
-    EXPECT_EQ(to_unit(0), 0.0);
+    EXPECT_EQ(to_unit(std::uint64_t{0}), 0.0);
     EXPECT_EQ(to_unit(~std::uint64_t{0}), 1.0 - 0x1.0p-53);
     EXPECT_LT(to_unit(~std::uint64_t{0}), 1.0);
     EXPECT_EQ(to_unit(std::uint64_t{1} << 63), 0.5);
     EXPECT_EQ(to_unit(std::uint64_t{1} << 11), 0x1.0p-53);
     // The low 11 bits do not matter.
-    EXPECT_EQ(to_unit(0x7ff), 0.0);
+    EXPECT_EQ(to_unit(std::uint64_t{0x7ff}), 0.0);
 
     double sum = 0;
     const int n = 100000;

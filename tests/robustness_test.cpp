@@ -10,6 +10,7 @@
 #include <string>
 
 #include "drt/integrator.h"
+#include "drt/multi_jittered.h"
 #include "drt/renderer.h"
 #include "drt/scene_loader.h"
 #include "test_scenes.h"

@@ -1,0 +1,212 @@
+#include "drt/multi_jittered.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <span>
+#include <vector>
+
+#include "drt/rng.h"
+
+namespace drt {
+
+namespace {
+
+// Uniform random choices from few hashes: each choice of one of c takes the next digit of a
+// 32-bit random fraction f in radix c (the digit floor(f c), and f becomes frac(f c)), so one
+// hash serves several choices. A new hash is drawn before the digits taken so far would leave
+// under 12 bits of the fraction, which keeps every choice within 2^-12 of its share in relative
+// terms (and the sets the choices make are averaged over millions of shading points).
+class Digits {
+  public:
+    // The first digits come from `first`, later ones from hashes of `seed`.
+    Digits(std::uint32_t first, std::uint64_t seed) : seed_(seed), fraction_(first) {}
+
+    // Uniform in [0, c), for 1 <= c <= 2^12.
+    std::uint32_t below(std::uint32_t c) {
+        if (used_ * c > kMaxUsed) fraction_ = fresh(), used_ = 1;
+        used_ *= c;
+        const std::uint64_t product = std::uint64_t{fraction_} * c;
+        fraction_ = static_cast<std::uint32_t>(product);
+        return static_cast<std::uint32_t>(product >> 32);
+    }
+
+  private:
+    static constexpr std::uint64_t kMaxUsed = 1u << 20;  // of the fraction's 32 bits
+    std::uint32_t fresh() { return static_cast<std::uint32_t>(mix64(seed_ + ++draws_) >> 32); }
+
+    std::uint64_t seed_;
+    std::uint64_t draws_ = 0, used_ = 1;
+    std::uint32_t fraction_;
+};
+
+// Every order of 0 .. n-1 for n up to kListedOrders, as n hexadecimal digits (digit c is the
+// c-th element), in lexicographic order.
+constexpr std::uint32_t kListedOrders = 5;
+using OrderList = std::array<std::uint32_t, 1 + 1 + 2 + 6 + 24 + 120>;  // sum of n! for n <= 5
+constexpr std::array<std::uint32_t, kListedOrders + 2> kOrderListStart = {0, 1, 2, 4, 10, 34, 154};
+constexpr OrderList kOrders = [] {
+    OrderList list{};
+    for (std::uint32_t n = 0; n <= kListedOrders; ++n) {
+        std::array<std::uint32_t, kListedOrders> order{};
+        for (std::uint32_t c = 0; c < n; ++c) order[c] = c;
+        for (std::uint32_t i = kOrderListStart[n]; i < kOrderListStart[n + 1]; ++i) {
+            for (std::uint32_t c = 0; c < n; ++c) list[i] |= order[c] << (4 * c);
+            std::next_permutation(order.begin(), order.begin() + n);
+        }
+    }
+    return list;
+}();
+
+// A uniformly random order of 0 .. out.size()-1: one of the listed orders when they are few,
+// else dealt by Fisher-Yates.
+void shuffle(std::span<std::uint32_t> out, Digits& digits) {
+    const auto size = static_cast<std::uint32_t>(out.size());
+    if (size <= kListedOrders) {
+        const std::uint32_t start = kOrderListStart[size];
+        const std::uint32_t order =
+            kOrders[start + digits.below(kOrderListStart[size + 1] - start)];
+        for (std::uint32_t c = 0; c < size; ++c) out[c] = (order >> (4 * c)) & 15u;
+        return;
+    }
+    for (std::uint32_t c = 0; c < out.size(); ++c) out[c] = c;
+    for (auto c = static_cast<std::uint32_t>(out.size()); c > 1; --c) {
+        std::swap(out[c - 1], out[digits.below(c)]);
+    }
+}
+
+// A 32-bit bijective hash with full avalanche (Wellons' "lowbias32" constants); 32-bit
+// multiplies, unlike 64-bit ones, vectorise on x86 before AVX-512.
+constexpr std::uint32_t hash32(std::uint32_t x) {
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    return x ^ (x >> 16);
+}
+
+// The grid of a pattern of k points keyed by `key`, its shuffled columns and sub-columns, the
+// jitters' key and a set's rotation: what every point of the pattern shares.
+//
+// The shuffles are dealt by Fisher-Yates from the digits of as few hashes as they need (one for
+// k up to 20), or picked from the list of all orders when a side has at most five elements;
+// beyond kDealtUpTo points, where a side's deal would need many hashes, they are Kensler's
+// permutation, evaluated per element. (Both are uniformly random orders; dealing is the cheaper
+// for the small sets that every shading point draws.)
+class Grid {
+    static constexpr std::uint32_t kDealtUpTo = 1024;
+    static constexpr std::uint32_t kSmallSide = 64;  // the sides of k up to 4032 points
+    using Small = std::array<std::uint32_t, kSmallSide>;
+    static std::span<std::uint32_t> side(Small& small, std::vector<std::uint32_t>& large,
+                                         std::uint32_t size) {
+        if (size <= kSmallSide) return std::span(small).first(size);
+        large.resize(size);
+        return large;
+    }
+
+    // Declared first: the spans below point into them.
+    Small column_small_, sub_column_small_;
+    std::vector<std::uint32_t> column_large_, sub_column_large_;
+
+  public:
+    std::uint32_t m, n;
+    double inv_m, inv_cells, inv_k;
+    std::uint64_t jitter_key;
+    std::uint32_t rotation;
+    std::span<std::uint32_t> column, sub_column;
+
+    Grid(std::uint32_t k, std::uint32_t key)
+        : m(std::max(1u, static_cast<std::uint32_t>(std::sqrt(double(k))))),  // floor
+          n((k + m - 1) / m),
+          inv_m(1.0 / m),
+          inv_cells(1.0 / (double(m) * n)),
+          inv_k(1.0 / k),
+          column(side(column_small_, column_large_, m)),
+          sub_column(side(sub_column_small_, sub_column_large_, n)) {
+        const std::uint64_t h = mix64(key ^ 0x7f4a7c159e3779b9ULL);
+        jitter_key = mix64(h);
+        Digits digits(static_cast<std::uint32_t>(h >> 32), h ^ 0x68bc21ebu);
+        if (k <= kDealtUpTo) {
+            shuffle(column, digits);
+            shuffle(sub_column, digits);
+        } else {
+            for (std::uint32_t c = 0; c < m; ++c) column[c] = permute(c, m, key * 0x68bc21ebu);
+            for (std::uint32_t r = 0; r < n; ++r) sub_column[r] = permute(r, n, key * 0x02e5be93u);
+        }
+        rotation = k <= 4096 ? digits.below(k) : static_cast<std::uint32_t>(((h >> 32) * k) >> 32);
+    }
+    Grid(const Grid&) = delete;
+    Grid& operator=(const Grid&) = delete;
+};
+
+// The points of strata strata[i] into out[i]: stratum s = row * m + col takes the cell
+// (column[col], sub_column[row]), x = (column[col] * n + sub_column[row] + jx) / (m n) and
+// y = (s + jy) / k. The jitters' 32 bits keep both below 1 for any k < 2^20, and the clamp
+// beyond. s / m is computed in floating point, exactly (the product is within 2^-51 n of
+// (s + 1/2) / m, whose distance to an integer is at least 1/(2m)), so that the loop vectorises;
+// the divisions by m n and k are products for the same reason.
+DRT_VECTORISED void grid_points(const Grid& grid, const std::uint32_t* strata, Vec2* out,
+                                std::size_t count) {
+    constexpr double kBelowOne = 0x1.fffffffffffffp-1;
+    const std::uint32_t* column = grid.column.data();
+    const std::uint32_t* sub_column = grid.sub_column.data();
+    const std::uint32_t m = grid.m, n = grid.n;
+    const double inv_m = grid.inv_m, inv_cells = grid.inv_cells, inv_k = grid.inv_k;
+    const auto key_x = static_cast<std::uint32_t>(grid.jitter_key),
+               key_y = static_cast<std::uint32_t>(grid.jitter_key >> 32);
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::uint32_t s = strata[i];
+        const auto row = static_cast<std::uint32_t>(
+            static_cast<std::int32_t>((static_cast<double>(s) + 0.5) * inv_m));
+        const std::uint32_t cell = column[s - row * m] * n + sub_column[row];
+        const std::uint32_t jx = hash32(s + key_x);
+        const std::uint32_t jy = hash32(jx ^ key_y);
+        const double x = (static_cast<double>(cell) + to_unit(jx)) * inv_cells;
+        const double y = (static_cast<double>(s) + to_unit(jy)) * inv_k;
+        out[i] = {x < kBelowOne ? x : kBelowOne, y < kBelowOne ? y : kBelowOne};
+    }
+}
+
+// Labels are handled a batch at a time, so that a run of any length needs no allocation.
+constexpr std::size_t kBatch = 256;
+
+}  // namespace
+
+void multi_jittered(std::uint32_t first, std::uint32_t k, std::uint32_t key, std::span<Vec2> out) {
+    const Grid grid(k, key);
+    const std::uint32_t stratum_key = key * 0x51633e2du;
+    std::array<std::uint32_t, kBatch> strata;
+    for (std::size_t done = 0; done < out.size(); done += kBatch) {
+        const std::size_t count = std::min(kBatch, out.size() - done);
+        for (std::size_t i = 0; i < count; ++i) {
+            strata[i] = permute(first + static_cast<std::uint32_t>(done + i), k, stratum_key);
+        }
+        grid_points(grid, strata.data(), out.data() + done, count);
+    }
+}
+
+Vec2 multi_jittered(std::uint32_t j, std::uint32_t k, std::uint32_t key) {
+    Vec2 point;
+    multi_jittered(j, k, key, {&point, 1});
+    return point;
+}
+
+void multi_jittered_set(std::uint32_t first, std::uint32_t k, std::uint32_t key,
+                        std::span<Vec2> out) {
+    const Grid grid(k, key);
+    std::array<std::uint32_t, kBatch> strata;
+    std::uint32_t start = (first % k + grid.rotation) % k;
+    // At most k labels at a time, so that the strata wrap around at most once.
+    const std::size_t most = std::min<std::size_t>(kBatch, k);
+    for (std::size_t done = 0; done < out.size(); done += most) {
+        const std::size_t count = std::min(most, out.size() - done);
+        for (std::size_t i = 0; i < count; ++i) {
+            const std::uint32_t s = start + static_cast<std::uint32_t>(i);
+            strata[i] = s < k ? s : s - k;
+        }
+        grid_points(grid, strata.data(), out.data() + done, count);
+        start = static_cast<std::uint32_t>((start + count) % k);
+    }
+}
+
+}  // namespace drt
