@@ -47,6 +47,11 @@ TEST(Rng, ToUnitCoversTheHalfOpenUnitInterval) {
     EXPECT_EQ(to_unit(std::uint64_t{1} << 11), 0x1.0p-53);
     // The low 11 bits do not matter.
     EXPECT_EQ(to_unit(std::uint64_t{0x7ff}), 0.0);
+    // A 32-bit word converts exactly.
+    EXPECT_EQ(to_unit(std::uint32_t{0}), 0.0);
+    EXPECT_EQ(to_unit(std::uint32_t{1} << 31), 0.5);
+    EXPECT_EQ(to_unit(std::uint32_t{1}), 0x1.0p-32);
+    EXPECT_EQ(to_unit(~std::uint32_t{0}), 1.0 - 0x1.0p-32);
 
     double sum = 0;
     const int n = 100000;
