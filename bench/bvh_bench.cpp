@@ -4,6 +4,7 @@
 
 #include "bench_world.h"
 #include "drt/bvh.h"
+#include "drt/occluders.h"
 #include "drt/plane.h"
 
 namespace drt::bench {
@@ -66,7 +67,7 @@ void BM_RoomShadowRays(benchmark::State& state) {
     std::size_t i = 0, blocked = 0;
     for (auto _ : state) {
         const Vec3 origin{800 * unit(9, i), 1e-6, 800 * unit(10, i)};
-        const Occluders occluders = gather ? bvh.gather_occluders(origin, light, 0) : Occluders{};
+        const Occluders occluders = gather ? Occluders(bvh, origin, light, 0) : Occluders{};
         for (std::size_t j = 0; j < 9; ++j) {
             const Vec3 target =
                 light.centre + Vec3{unit(11, 9 * i + j) - 0.5, unit(12, 9 * i + j) - 0.5,
@@ -74,7 +75,7 @@ void BM_RoomShadowRays(benchmark::State& state) {
                                    40.0;
             const Vec3 d = target - origin;
             const Ray ray{origin, d / length(d), 0};
-            blocked += bvh.occluded(ray, {0, length(d) - 40}, occluders);
+            blocked += occluders.occluded(bvh, ray, {0, length(d) - 40});
         }
         ++i;
     }

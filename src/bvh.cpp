@@ -22,7 +22,6 @@ constexpr double kTraversalCost = 1.0;  // relative to one primitive test
 // Past this depth nodes split at the median, which bounds the depth of any tree by
 // kMedianDepth + log2(n) and so keeps the traversal stack below kStackSize.
 constexpr int kMedianDepth = 64;
-constexpr int kStackSize = 128;
 // Slab distances are rounded; stretching the far one by a few ulps keeps a box whose surface a
 // ray grazes from being missed (pbrt's 1 + 2γ₃).
 constexpr double kFarStretch = 1.0 + 4.0 * std::numeric_limits<double>::epsilon();
@@ -224,18 +223,12 @@ std::optional<double> Bvh::hit_segment(const Primitive& p, const Ray& ray, doubl
     return intersect_sphere(motions_[p.motion].at(ray.time), p.radius, ray, origin_scale, range);
 }
 
-inline Ball Bvh::ball_at(const Primitive& p, double time) const {
-    if (p.kind == Kind::kStillSphere) return {p.centre, p.radius};
-    return {motions_[p.motion].at(time), p.radius};
-}
-
 template <bool kAnyHit>
-bool Bvh::traverse(const Ray& ray, Interval& range, const Occluders& occluders,
-                   Nearest& nearest) const {
+bool Bvh::traverse(const Ray& ray, Interval& range, std::uint64_t planes, Nearest& nearest) const {
     const double origin_scale = max_abs_component(ray.origin);
     bool found = false;
     for (std::size_t i = 0; i < planes_.size(); ++i) {
-        if (i < 64 && (occluders.planes >> i & 1) == 0) continue;
+        if (i < 64 && (planes >> i & 1) == 0) continue;
         const PlaneData& plane = planes_[i];
         if (auto t = intersect_plane(plane.point, plane.normal, plane.point_scale, ray,
                                      origin_scale, range)) {
@@ -306,24 +299,19 @@ bool Bvh::traverse(const Ray& ray, Interval& range, const Occluders& occluders,
 
 std::optional<Hit> Bvh::intersect(const Ray& ray, Interval range) const {
     Nearest nearest;
-    if (!traverse<false>(ray, range, Occluders{}, nearest)) return std::nullopt;
+    if (!traverse<false>(ray, range, kAllPlanes, nearest)) return std::nullopt;
     return Hit{range.max, objects_[nearest.object], nearest.index, nearest.uv};
 }
 
-bool Bvh::occluded(const Ray& ray, Interval range) const {
+bool Bvh::occluded(const Ray& ray, Interval range, std::uint64_t planes) const {
     Nearest unused;
-    return traverse<true>(ray, range, Occluders{}, unused);
+    return traverse<true>(ray, range, planes, unused);
 }
 
-bool Bvh::occluded(const Ray& ray, Interval range, const Occluders& occluders) const {
-    if (occluders.nothing) return false;
-    if (occluders.everything) {
-        Nearest unused;
-        return traverse<true>(ray, range, occluders, unused);
-    }
-    // Only what was gathered: the planes whose bits are set and the listed primitives.
+bool Bvh::occluded_by(const Ray& ray, Interval range, std::uint64_t planes,
+                      std::span<const std::uint32_t> primitives) const {
     const double origin_scale = max_abs_component(ray.origin);
-    for (std::uint64_t left = occluders.planes; left != 0; left &= left - 1) {
+    for (std::uint64_t left = planes; left != 0; left &= left - 1) {
         const PlaneData& p = planes_[static_cast<std::size_t>(std::countr_zero(left))];
         if (intersect_plane(p.point, p.normal, p.point_scale, ray, origin_scale, range))
             return true;
@@ -333,117 +321,11 @@ bool Bvh::occluded(const Ray& ray, Interval range, const Occluders& occluders) c
         if (intersect_plane(p.point, p.normal, p.point_scale, ray, origin_scale, range))
             return true;
     }
-    for (int i = 0; i < occluders.count; ++i) {
-        Vec2 uv;
-        if (hit(primitives_[occluders.primitives[i]], ray, origin_scale, range, uv)) return true;
+    Vec2 uv;
+    for (const std::uint32_t i : primitives) {
+        if (hit(primitives_[i], ray, origin_scale, range, uv)) return true;
     }
     return false;
-}
-
-namespace {
-
-// Slack, relative to the scene's coordinates and to cosines, by which the culling below errs on
-// the side of keeping: far above rounding, far below anything a scene could notice.
-constexpr double kSlack = 1e-9;
-
-// The cone of segments from an apex to the points of a ball, and whether a ball may meet one.
-struct SegmentCone {
-    Vec3 apex, axis;
-    double sin_a, cos_a;  // of its half-angle
-    double reach;         // no segment is longer
-    double slack;         // absolute, for distances
-
-    // Whether some segment may pass through the ball (centre, radius): conservative.
-    bool may_meet(const Vec3& centre, double radius) const {
-        const Vec3 v = centre - apex;
-        const double d2 = dot(v, v);
-        if (d2 <= radius * radius) return true;  // the apex is in it
-        const double r = radius + slack;
-        const double along = dot(v, axis);
-        if (along - r > reach) return false;  // wholly beyond the farthest segment's end
-        // Within the sum of the half-angles a of the cone and b of the ball about the axis:
-        // angle(v, axis) <= a + b, that is along >= |v| cos(a + b) = cos a |v| cos b - sin a r,
-        // where |v| cos b = sqrt(|v|² - r²) (0 when the apex is within the slack of the ball,
-        // which then looks like a half-space: missed when the whole light is above its plane).
-        const double tangent = std::sqrt(positive_part(d2 - r * r));
-        return along >= cos_a * tangent - sin_a * r - kSlack * (tangent + r);
-    }
-};
-
-}  // namespace
-
-Occluders Bvh::gather_occluders(const Vec3& origin, const Ball& target, double time) const {
-    Occluders found;
-    const double slack =
-        kSlack * (max_abs_component(origin) + max_abs_component(target.centre) + target.radius);
-    const Vec3 w = target.centre - origin;
-    const double d2 = dot(w, w);
-    // The distance and the tangent's length side by side rather than one after the other: the
-    // cone's cosine sqrt(1 - sin²) would wait on the sine, which waits on the distance.
-    const double reach = std::sqrt(d2);
-    const double tangent = std::sqrt(positive_part(d2 - target.radius * target.radius));
-    // From inside the ball, or next to it, segments go every way: keep everything.
-    if (!(reach > target.radius + slack)) return found;
-    const double inverse = 1.0 / reach;
-    const SegmentCone cone{origin,
-                           w * inverse,
-                           target.radius * inverse,
-                           tangent * inverse,
-                           reach + target.radius + slack,
-                           slack};
-
-    // A plane can block only if the origin and the ball are not both strictly on one side of it.
-    found.planes = 0;
-    const double origin_scale = max_abs_component(origin);
-    for (std::size_t i = 0; i < planes_.size() && i < 64; ++i) {
-        const PlaneData& p = planes_[i];
-        // The origin may be as close as a spawned ray's offset, far above rounding; the ball is
-        // held to the coarser slack.
-        const double near = 1e-12 * (origin_scale + p.point_scale);
-        const double margin = slack + kSlack * p.point_scale;
-        const double from = dot(origin, p.normal) - p.offset;
-        const double to = dot(target.centre, p.normal) - p.offset;
-        // Without branches: which planes separate varies from point to point, unpredictably.
-        const bool apart = ((from > near) & (to - target.radius > margin)) |
-                           ((from < -near) & (to + target.radius < -margin));
-        found.planes |= std::uint64_t{!apart} << i;
-    }
-
-    const bool only_listed = planes_.size() <= 64;
-    if (nodes_.empty()) {
-        found.everything = false;
-        found.nothing = only_listed && found.planes == 0;
-        return found;
-    }
-    std::array<std::uint32_t, kStackSize> stack;
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-        const Node& node = nodes_[stack[--top]];
-        if (!(node.time_min <= time && time <= node.time_max)) continue;
-        const Vec3 lo{node.box[0], node.box[1], node.box[2]};
-        const Vec3 hi{node.box[3], node.box[4], node.box[5]};
-        // (A tree that is a single leaf goes straight to its few primitives.)
-        if (nodes_.size() > 1 && !cone.may_meet((lo + hi) * 0.5, 0.5 * length(hi - lo))) {
-            continue;
-        }
-        if (node.count == 0) {
-            stack[top++] = node.offset;
-            stack[top++] = static_cast<std::uint32_t>(&node - nodes_.data()) + 1;
-            continue;
-        }
-        for (std::uint32_t i = node.offset; i < node.offset + node.count; ++i) {
-            const Primitive& p = primitives_[i];
-            if (!p.time.contains(time)) continue;
-            const Ball ball = ball_at(p, time);
-            if (!cone.may_meet(ball.centre, ball.radius)) continue;
-            if (found.count == Occluders::kMaxListed) return found;  // too many: traverse instead
-            found.primitives[found.count++] = i;
-        }
-    }
-    found.everything = false;
-    found.nothing = only_listed && found.planes == 0 && found.count == 0;
-    return found;
 }
 
 }  // namespace drt

@@ -185,7 +185,7 @@ Color Integrator::light_ray(const Light& light, const LightSample& ls, const Vec
     const double cosine = lit_cosine(ls.dir, shading, geometric);
     if (cosine == 0) return {};  // no ray needed
     ++counts.shadow;
-    if (bvh_.occluded({origin, ls.dir, time}, {0, ls.distance}, occluders)) return {};
+    if (occluders.occluded(bvh_, {origin, ls.dir, time}, {0, ls.distance})) return {};
     return light.intensity() * cosine;
 }
 
@@ -206,10 +206,10 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
         if (rays == 0) continue;
         const Light& light = *scene_.lights[i];
         const std::uint32_t dimension = dim::light(depth, i);
-        // What can block this point's rays to this light, found once for all of them when they
-        // are several; a lone ray is as cheap to trace through everything.
+        // What can block this point's rays to this light, found once for all of them when
+        // worth_culling says so (occluders.h), which decides how they are shaded below.
         const Occluders occluders =
-            rays >= 3 ? bvh_.gather_occluders(origin, light.extent(), time) : Occluders{};
+            worth_culling(rays, bvh_) ? Occluders(bvh_, origin, light.extent(), time) : Occluders{};
         Color light_sum;
         for (int first = 0; first < rays; first += kChunk) {
             const auto n = static_cast<std::size_t>(std::min(kChunk, rays - first));
@@ -222,7 +222,7 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
                                     static_cast<std::uint32_t>(first), std::span(points).first(n));
             }
             const auto chunk = std::span<const Vec2>(points).first(n);
-            if (occluders.nothing) {
+            if (occluders.every_ray_reaches()) {
                 // Every ray reaches the light: only the cosines are needed.
                 light.lit_cosines(point, shading, geometric, chunk, std::span(cosines).first(n));
                 double cosine_sum = 0;

@@ -1,6 +1,5 @@
-// The BVH and the shadow-ray shortcuts against brute force: nearest hits and any-hit answers
-// must be exactly those of testing every object, and the occluders gathered for a light must
-// never change an answer. Also the fast kernels those rays use: quarter-turn sines and batched
+// The BVH against brute force: nearest hits and any-hit answers must be exactly those of
+// testing every object. Also the fast kernels those rays use: quarter-turn sines and batched
 // light samples.
 #include "drt/bvh.h"
 
@@ -19,61 +18,15 @@
 #include "drt/rng.h"
 #include "drt/sampler.h"
 #include "drt/sphere.h"
+#include "test_world.h"
 
 namespace drt {
 namespace {
 
-double unit(std::uint64_t stream, std::uint64_t i) {
-    return to_unit(hash_of(stream, i));
-}
-Vec3 point_in(std::uint64_t stream, std::uint64_t i, double lo, double hi) {
-    return {lo + (hi - lo) * unit(stream, 3 * i), lo + (hi - lo) * unit(stream, 3 * i + 1),
-            lo + (hi - lo) * unit(stream, 3 * i + 2)};
-}
-Vec3 direction(std::uint64_t stream, std::uint64_t i) {
-    const double z = 1 - 2 * unit(stream, 2 * i);
-    const double phi = 2 * kPi * unit(stream, 2 * i + 1);
-    const double s = std::sqrt(1 - z * z);
-    return {s * std::cos(phi), s * std::sin(phi), z};
-}
-
-// A room of planes around spheres, some of them moving along paths of one or two segments.
-struct World {
-    Material material;
-    std::vector<std::unique_ptr<Object>> objects;
-
-    World(int spheres, std::uint64_t seed) {
-        material.diffuse = 1;
-        objects.push_back(std::make_unique<Plane>(Vec3{0, 0, 0}, Vec3{0, 1, 0}, material));
-        objects.push_back(std::make_unique<Plane>(Vec3{0, 100, 0}, Vec3{0, -1, 0}, material));
-        objects.push_back(std::make_unique<Plane>(Vec3{-5, 0, 0}, Vec3{1, 0.2, 0}, material));
-        for (int i = 0; i < spheres; ++i) {
-            std::vector<Vec3> path{point_in(seed, i, 5, 95)};
-            const int segments = i % 3;  // still, one segment, two segments
-            for (int k = 0; k < segments; ++k)
-                path.push_back(path.back() + point_in(seed + 1, 3 * i + k, -6, 6));
-            objects.push_back(
-                std::make_unique<Sphere>(std::move(path), 1 + 6 * unit(seed + 2, i), material));
-        }
-    }
-
-    std::optional<Hit> brute_nearest(const Ray& ray, Interval range) const {
-        std::optional<Hit> nearest;
-        for (const auto& object : objects) {
-            if (auto hit = object->intersect(ray, range)) {
-                nearest = hit;
-                range.max = hit->t;
-            }
-        }
-        return nearest;
-    }
-    bool brute_occluded(const Ray& ray, Interval range) const {
-        for (const auto& object : objects) {
-            if (object->intersect(ray, range)) return true;
-        }
-        return false;
-    }
-};
+using testing::direction;
+using testing::point_in;
+using testing::unit;
+using testing::World;
 
 TEST(Bvh, NearestHitIsThatOfTestingEveryObject) {
     for (const int count : {1, 3, 40, 600}) {
@@ -207,75 +160,6 @@ TEST(Bvh, SurfaceOfAHitRecordIsWhereTheRayMetTheShape) {
     }
     EXPECT_GT(spheres, 100);
     EXPECT_GT(planes, 100);
-}
-
-// Shadow rays from points on and off the surfaces to points of a light: the gathered occluders
-// must give exactly the answer of the whole scene, from a floor point, a sphere's surface, a
-// point in free space, and with more spheres in the way than the list holds.
-TEST(Bvh, GatheredOccludersNeverChangeAShadowRaysAnswer) {
-    for (const int count : {2, 12, 200}) {
-        const World world(count, 40 + count);
-        const Bvh bvh(world.objects);
-        int gathered = 0, blocked = 0, rays = 0;
-        for (std::uint64_t p = 0; p < 300; ++p) {
-            const double time = 2.5 * unit(41, p);
-            const Ball light{point_in(42, p, 10, 90), 2 + 10 * unit(43, p)};
-            Vec3 point = point_in(44, p, 5, 95), normal = direction(45, p);
-            if (p % 3 == 0) point.y = 0, normal = {0, 1, 0};  // on the floor
-            if (p % 3 == 1) {
-                // On a sphere (at the ray's time), as a hit point would be.
-                const auto* sphere =
-                    dynamic_cast<const Sphere*>(world.objects[3 + p % count].get());
-                normal = direction(46, p);
-                point = sphere->path().at(time) + normal * sphere->radius();
-            }
-            const Ray leaving = spawn_ray(point, normal, normal, time);
-            const Occluders occluders = bvh.gather_occluders(leaving.origin, light, time);
-            gathered += !occluders.everything;
-            for (std::uint64_t j = 0; j < 40; ++j) {
-                const Vec3 target = light.centre + direction(47, p * 40 + j) *
-                                                       (light.radius * unit(48, p * 40 + j));
-                const Vec3 d = target - leaving.origin;
-                const Ray ray{leaving.origin, d / length(d), time};
-                if (dot(ray.dir, normal) <= 0) continue;  // shadow rays leave above the surface
-                const Interval range{0, length(d)};
-                const bool expected = bvh.occluded(ray, range);
-                ASSERT_EQ(bvh.occluded(ray, range, occluders), expected)
-                    << count << " point " << p << " ray " << j;
-                blocked += expected, ++rays;
-            }
-        }
-        // Both answers occur (few with two spheres in a large room), and the lists are used.
-        EXPECT_GT(blocked, count < 10 ? 5 : rays / 50) << count;
-        EXPECT_LT(blocked, rays - rays / 50) << count;
-        if (count <= 12) {
-            EXPECT_GT(gathered, 150) << count;
-        }
-    }
-}
-
-TEST(Bvh, FromInsideTheLightEverythingIsKept) {
-    const World world(5, 3);
-    const Bvh bvh(world.objects);
-    const Occluders inside = bvh.gather_occluders({50, 50, 50}, {{50, 52, 50}, 5}, 0);
-    EXPECT_TRUE(inside.everything);
-    EXPECT_FALSE(inside.nothing);
-    EXPECT_EQ(inside.planes, ~std::uint64_t{0});
-    // Far from every plane and sphere, towards a light in open space, nothing needs testing.
-    Material material;
-    std::vector<std::unique_ptr<Object>> objects;
-    objects.push_back(std::make_unique<Plane>(Vec3{0, 0, 0}, Vec3{0, 1, 0}, material));
-    objects.push_back(std::make_unique<Sphere>(std::vector<Vec3>{{100, 10, 0}}, 5.0, material));
-    const Bvh room(objects);
-    const Occluders none = room.gather_occluders({0, 10, 0}, {{0, 50, 0}, 5}, 0);
-    EXPECT_FALSE(none.everything);
-    EXPECT_EQ(none.planes, 0u);
-    EXPECT_EQ(none.count, 0);
-    EXPECT_TRUE(none.nothing);
-    // Towards a light beyond the plane, the plane may block.
-    const Occluders plane = room.gather_occluders({0, 10, 0}, {{0, -50, 0}, 5}, 0);
-    EXPECT_FALSE(plane.nothing);
-    EXPECT_EQ(plane.planes, 1u);
 }
 
 TEST(FastKernels, SinCosOfTurnsIsWithinTwoUlpsAndExactAtQuarters) {

@@ -12,24 +12,12 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "drt/object.h"
 
 namespace drt {
-
-// What may block the segments from one origin to the points of one ball (a light) at one time:
-// the planes and primitives that meet the cone those segments fill. Bvh::gather_occluders finds
-// them once for a shading point and a light; each of the point's shadow rays then tests only
-// them. The default holds everything, which is always correct.
-struct Occluders {
-    static constexpr int kMaxListed = 16;
-    std::uint64_t planes = ~std::uint64_t{0};  // bit i: plane i may block (from the 65th, all may)
-    bool everything = true;                    // whether to traverse the tree instead of the list
-    bool nothing = false;                      // nothing at all may block: no ray need be traced
-    int count = 0;
-    std::array<std::uint32_t, kMaxListed> primitives{};
-};
 
 class Bvh {
   public:
@@ -37,13 +25,30 @@ class Bvh {
 
     std::optional<Hit> intersect(const Ray& ray, Interval range) const;
     // Whether anything blocks the ray within range (any hit will do, so it stops at the first).
-    bool occluded(const Ray& ray, Interval range) const;
-    // The same for a ray from `origin` to a point of the ball the occluders were gathered for,
-    // at their time, testing only them.
-    bool occluded(const Ray& ray, Interval range, const Occluders& occluders) const;
-    Occluders gather_occluders(const Vec3& origin, const Ball& target, double time) const;
+    bool occluded(const Ray& ray, Interval range) const { return occluded(ray, range, kAllPlanes); }
 
     std::size_t node_count() const { return nodes_.size(); }
+
+    // What the shadow-ray culling (occluders.h) reads and tests.
+    struct PlaneData {
+        Vec3 point, normal;
+        double point_scale;  // max_abs_component(point)
+        double offset;       // dot(point, normal)
+        std::uint32_t object, index;
+    };
+    static constexpr std::uint64_t kAllPlanes = ~std::uint64_t{0};
+    std::span<const PlaneData> planes() const { return planes_; }
+    // Whether the ray is blocked within range by a plane whose bit is set in `planes` (planes
+    // past the 64th always count) or by anything in the tree.
+    bool occluded(const Ray& ray, Interval range, std::uint64_t planes) const;
+    // The same, testing only the listed primitives (as visit_near names them) of the tree.
+    bool occluded_by(const Ray& ray, Interval range, std::uint64_t planes,
+                     std::span<const std::uint32_t> primitives) const;
+    // Calls visit(i) for each primitive i present at `time` whose ball at that time passes
+    // `may_meet` (a conservative test of a Ball), skipping subtrees whose bounding ball fails
+    // it; stops, returning false, as soon as visit returns false.
+    template <class MayMeet, class Visit>
+    bool visit_near(double time, const MayMeet& may_meet, const Visit& visit) const;
 
   private:
     enum class Kind : std::uint32_t { kStillSphere, kMovingSphere };
@@ -57,12 +62,6 @@ class Bvh {
         std::uint32_t index;   // Hit::primitive: which of the object's shapes
         Kind kind;
         std::uint32_t motion;  // index into motions_ for a moving sphere
-    };
-    struct PlaneData {
-        Vec3 point, normal;
-        double point_scale;  // max_abs_component(point)
-        double offset;       // dot(point, normal)
-        std::uint32_t object, index;
     };
     // A node is one cache line: its box, the time span of what it holds (rounded outwards to
     // float), and its primitives (leaf) or its second child (inner; the first follows it).
@@ -79,6 +78,9 @@ class Bvh {
     };
     struct RayData;
 
+    // Deep enough for any tree: the build splits at the median past a depth of 64.
+    static constexpr int kStackSize = 128;
+
     std::uint32_t build(std::vector<Build>& items, std::uint32_t begin, std::uint32_t end,
                         int depth);
     // What a traversal keeps of the nearest hit so far (its t is the range's end).
@@ -89,8 +91,7 @@ class Bvh {
     // Whether the ray hits anything within range; the nearest hit (or, for kAnyHit, the first
     // found) shrinks range.max to its t and is described in `nearest`.
     template <bool kAnyHit>
-    bool traverse(const Ray& ray, Interval& range, const Occluders& occluders,
-                  Nearest& nearest) const;
+    bool traverse(const Ray& ray, Interval& range, std::uint64_t planes, Nearest& nearest) const;
     // The one leaf test: the ray parameter inside `range` at which the ray meets primitive p at
     // the ray's time. `uv` receives the primitive's own coordinates where its test yields them.
     std::optional<double> hit(const Primitive& p, const Ray& ray, double origin_scale,
@@ -98,7 +99,10 @@ class Bvh {
     std::optional<double> hit_segment(const Primitive& p, const Ray& ray, double origin_scale,
                                       Interval range) const;
     // Where primitive p is at `time`, as a ball (for the shadow-ray culling).
-    Ball ball_at(const Primitive& p, double time) const;
+    Ball ball_at(const Primitive& p, double time) const {
+        if (p.kind == Kind::kStillSphere) return {p.centre, p.radius};
+        return {motions_[p.motion].at(time), p.radius};
+    }
 
     std::vector<const Object*> objects_;
     std::vector<Primitive> primitives_;  // in leaf order
@@ -106,5 +110,35 @@ class Bvh {
     std::vector<Node> nodes_;
     std::vector<PlaneData> planes_;
 };
+
+template <class MayMeet, class Visit>
+bool Bvh::visit_near(double time, const MayMeet& may_meet, const Visit& visit) const {
+    if (nodes_.empty()) return true;
+    std::array<std::uint32_t, kStackSize> stack;
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const std::uint32_t index = stack[--top];
+        const Node& node = nodes_[index];
+        if (!(node.time_min <= time && time <= node.time_max)) continue;
+        // (A tree that is a single leaf goes straight to its few primitives.)
+        if (nodes_.size() > 1) {
+            const Vec3 lo{node.box[0], node.box[1], node.box[2]};
+            const Vec3 hi{node.box[3], node.box[4], node.box[5]};
+            if (!may_meet(Ball{(lo + hi) * 0.5, 0.5 * length(hi - lo)})) continue;
+        }
+        if (node.count == 0) {
+            stack[top++] = node.offset;
+            stack[top++] = index + 1;
+            continue;
+        }
+        for (std::uint32_t i = node.offset; i < node.offset + node.count; ++i) {
+            const Primitive& p = primitives_[i];
+            if (!p.time.contains(time)) continue;
+            if (may_meet(ball_at(p, time)) && !visit(i)) return false;
+        }
+    }
+    return true;
+}
 
 }  // namespace drt

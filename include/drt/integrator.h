@@ -9,6 +9,7 @@
 
 #include "drt/bvh.h"
 #include "drt/camera.h"
+#include "drt/occluders.h"
 #include "drt/render_plan.h"
 #include "drt/sampler.h"
 #include "drt/scene.h"

@@ -35,7 +35,7 @@ class Light {
     virtual void lit_cosines(const Vec3& x, const Vec3& shading, const Vec3& geometric,
                              std::span<const Vec2> u, std::span<double> out) const;
     // A ball holding every point sample() aims at from outside it, so that what can block the
-    // shadow rays of a shading point can be found once for all of them (Bvh::gather_occluders).
+    // shadow rays of a shading point can be found once for all of them (Occluders, occluders.h).
     virtual Ball extent() const = 0;
     // A point light needs exactly one shadow ray; an area light's penumbra needs many.
     virtual bool is_point() const = 0;
