@@ -45,8 +45,9 @@ class LimitError : public std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
-// An integer option from `lowest` to `limit`. CLI11's own range checks print a double's bounds in
-// full (309 digits) and its unsigned conversion takes -1 for 2^64 - 1.
+// An integer option from `lowest` to `limit` (messages are made printable where they are shown).
+// CLI11's own range checks print a double's bounds in full (309 digits) and its unsigned conversion
+// takes -1 for 2^64 - 1.
 CLI::Validator integer_in(long long lowest, unsigned long long limit) {
     const std::string rule =
         "must be an integer from " + std::to_string(lowest) + " to " + std::to_string(limit);
@@ -65,7 +66,7 @@ CLI::Validator integer_in(long long lowest, unsigned long long limit) {
                 ok = ec == std::errc() && ptr == end && v >= lowest &&
                      static_cast<unsigned long long>(v) <= limit;
             }
-            return ok ? std::string() : rule + ", got " + printable(abbreviated(text));
+            return ok ? std::string() : rule + ", got " + abbreviated(text);
         },
         "INT in [" + std::to_string(lowest) + ", " + std::to_string(limit) + "]");
 }
@@ -78,7 +79,7 @@ CLI::Validator finite_positive() {
             const double v = std::strtod(text.c_str(), &end);
             const bool ok = !text.empty() && *end == '\0' && std::isfinite(v) && v > 0;
             return ok ? std::string()
-                      : "must be a finite positive number, got " + printable(abbreviated(text));
+                      : "must be a finite positive number, got " + abbreviated(text);
         },
         "POSITIVE");
 }

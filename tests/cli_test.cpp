@@ -213,7 +213,9 @@ class CliTest : public ::testing::Test {
         if (!HasFailure()) fs::remove_all(dir_);
     }
 
-    Outcome run(const std::vector<std::string>& args) const { return run_drt(args, dir_); }
+    Outcome run(const std::vector<std::string>& args, rlim_t address_space = 0) const {
+        return run_drt(args, dir_, address_space);
+    }
     fs::path file(const std::string& name) const { return dir_ / name; }
     // Every name in the folder, so a test can see that nothing (not even a temporary) was left.
     std::vector<std::string> entries(const fs::path& folder) const {
@@ -824,6 +826,213 @@ TEST_F(CliTest, ProgressAppearsOnATerminalUnlessQuiet) {
     const std::string quiet = run_drt_on_terminal(with(kSlowRender, {"-q"}), dir_);
     EXPECT_EQ(quiet, "");
 }
+
+// ---- robustness (issue 15): nothing a user types or feeds in crashes drt -----------------------
+
+// kScene with `from` replaced by `to`.
+std::string scene_with(const std::string& from, const std::string& to) {
+    std::string scene = kScene;
+    const std::size_t at = scene.find(from);
+    if (at == std::string::npos) throw std::invalid_argument(from);
+    return scene.replace(at, from.size(), to);
+}
+
+TEST_F(CliTest, OutputPathsThatCannotBeExaminedFailWithAMessage) {
+    const std::string long_name(300, 'a');  // past NAME_MAX
+    fs::create_symlink("loop", file("loop"));
+    for (const std::string& out : std::vector<std::string>{long_name + "/x.png", "loop/x.png"}) {
+        const Outcome r = run({"scene.xml", "-o", out, "-q"});
+        EXPECT_EQ(r.status, 1) << out;
+        EXPECT_TRUE(regex_search(r.err,
+                                 "x\\.png: cannot create file: (File name too long|Too "
+                                 "many levels of symbolic links)\n$"))
+            << r.err;
+    }
+    // As a batch folder: refused before any render, with the reason.
+    for (const std::string& out : std::vector<std::string>{long_name + "/", "loop/"}) {
+        const Outcome r = run({"scene.xml", "scene.xml", "-o", out, "-q"});
+        EXPECT_EQ(r.status, 1) << out;
+        EXPECT_NE(r.err.find(": cannot create folder: "), std::string::npos) << r.err;
+    }
+    // A name too long to examine is taken for a file name, not a folder.
+    const Outcome r = run({"scene.xml", "-o", long_name, "-q"});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("unsupported image format"), std::string::npos) << r.err;
+}
+
+TEST_F(CliTest, OptionsAtTheirLimitsAreAcceptedAndJustPastThemRefused) {
+    // `info` applies the overrides without rendering, so a limit can be tested at its value.
+    const std::vector<std::pair<std::string, std::string>> at_and_past{
+        {"--width", "65536"},
+        {"--height", "65536"},
+        {"--spp", "65536"},
+        {"--shadow-rays", "65536"},
+        {"--glossy-rays", "65536"},
+        {"--max-depth", "512"},
+        {"--seed", "18446744073709551615"}};
+    for (const auto& [option, limit] : at_and_past) {
+        const Outcome at = run({"info", "scene.xml", option, limit});
+        EXPECT_EQ(at.status, 0) << option << at.err;
+        const std::string past =
+            option == "--seed" ? "18446744073709551616" : std::to_string(std::stoll(limit) + 1);
+        const Outcome r = run({"scene.xml", option, past, "-o", "out.png"});
+        EXPECT_EQ(r.status, 2) << option;
+        const std::string lowest = option == "--max-depth" || option == "--seed" ? "0" : "1";
+        EXPECT_EQ(r.err, "drt: " + option + ": must be an integer from " + lowest + " to " + limit +
+                             ", got " + past + "\nRun 'drt --help' for usage.\n");
+    }
+    // --scale: the scaled size is checked (24x16 times 2730.66 is 65536 wide; 2731 is not).
+    EXPECT_EQ(run({"info", "scene.xml", "--scale", "2730.66"}).status, 0);
+    const Outcome scaled = run({"scene.xml", "--scale", "2731", "-o", "out.png"});
+    EXPECT_EQ(scaled.status, 2);
+    EXPECT_EQ(scaled.err,
+              "drt: scene.xml: --scale 2731 makes the image 65544x43696, past the limit of 65536 "
+              "pixels a side\n");
+    const Outcome huge = run({"scene.xml", "--scale", "1e9", "-o", "out.png"});
+    EXPECT_EQ(huge.err,
+              "drt: scene.xml: --scale 1e+09 makes the image 2.4e+10x1.6e+10, past "
+              "the limit of 65536 pixels a side\n");
+    // Pixels: each side within the limit, the product past it.
+    const Outcome pixels =
+        run({"scene.xml", "--width", "16385", "--height", "8192", "-o", "o.png"});
+    EXPECT_EQ(pixels.status, 2);
+    EXPECT_EQ(pixels.err,
+              "drt: scene.xml: image size 16385x8192 (134225920 pixels) exceeds the "
+              "limit of 134217728 pixels\n");
+    EXPECT_FALSE(fs::exists(file("out.png")));
+    EXPECT_FALSE(fs::exists(file("o.png")));
+}
+
+TEST_F(CliTest, NonFiniteNumbersAndNegativeSeedsAreRefusedLikeTheScenesOwn) {
+    for (const auto& [option, value] :
+         std::vector<std::pair<std::string, std::string>>{{"--scale", "nan"},
+                                                          {"--scale", "inf"},
+                                                          {"--noise-threshold", "nan"},
+                                                          {"--noise-threshold", "-inf"}}) {
+        const Outcome r = run({"scene.xml", option, value, "--stats", "s.json"});
+        EXPECT_EQ(r.status, 2) << option << value;
+        EXPECT_EQ(r.err, "drt: " + option + ": must be a finite positive number, got " + value +
+                             "\nRun 'drt --help' for usage.\n");
+        EXPECT_FALSE(fs::exists(file("s.json")));
+    }
+    const Outcome seed = run({"scene.xml", "--seed", "-1"});
+    EXPECT_EQ(seed.status, 2);
+    EXPECT_EQ(seed.err,
+              "drt: --seed: must be an integer from 0 to 18446744073709551615, got -1\n"
+              "Run 'drt --help' for usage.\n");
+    write_bytes(file("neg.xml"), scene_with("Seed=\"3\"", "Seed=\"-1\""));
+    const Outcome scene_seed = run({"neg.xml"});
+    EXPECT_EQ(scene_seed.status, 2);
+    EXPECT_EQ(scene_seed.err,
+              "neg.xml:4: Render: attribute 'Seed' is not a non-negative integer: \"-1\"\n");
+    // Range errors print their bounds and values short, never 309 digits.
+    const Outcome range = run({"scene.xml", "--scale", "-1e308"});
+    EXPECT_EQ(range.err,
+              "drt: --scale: must be a finite positive number, got -1e308\n"
+              "Run 'drt --help' for usage.\n");
+}
+
+TEST_F(CliTest, UnwritableStatsIsRefusedBeforeTheImageReplacesTheOutput) {
+    write_bytes(file("out.png"), "old");
+    fs::create_directories(file("stats.json"));
+    for (const std::string stats : {"missing/s.json", "stats.json"}) {
+        const Outcome r = run({"scene.xml", "-o", "out.png", "--stats", stats});
+        EXPECT_EQ(r.status, 2) << stats;
+        EXPECT_TRUE(regex_search(r.err,
+                                 "^drt: --stats .*s\\.json: cannot (create|write) file: "
+                                 "(No such file or directory|Is a directory)\n$"))
+            << r.err;
+        EXPECT_EQ(read_bytes(file("out.png")), "old");
+    }
+    EXPECT_EQ(entries(dir_), (std::vector<std::string>{"out.png", "scene.xml", "stats.json"}));
+}
+
+TEST_F(CliTest, NonFinitePixelsAreCountedAndFailTheRun) {
+    // Finite in the scene, beyond a float in the image: 1e39 and a background of 1.7e308.
+    write_bytes(file("bright.xml"), scene_with("Ir=\"1\"", "Ir=\"1e39\""));
+    const Outcome r = run({"bright.xml", "-o", "bright.pfm", "-q"});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_TRUE(regex_search(r.err,
+                             "^drt: bright\\.xml: [0-9]+ of 1152 channel values are not "
+                             "finite \\(radiance beyond the float range: a light, "
+                             "background or ambient too bright\\?\\)\n$"))
+        << r.err;
+    EXPECT_TRUE(fs::exists(file("bright.pfm")));  // kept for inspection
+    write_bytes(file("sky.xml"), scene_with("<Background r=\"0.1\"", "<Background r=\"1.7e308\""));
+    const Outcome sky = run({"sky.xml", "-o", "sky.pfm", "-q"});
+    EXPECT_EQ(sky.status, 2);
+    EXPECT_NE(sky.err.find("channel values are not finite"), std::string::npos) << sky.err;
+    EXPECT_EQ(run({"scene.xml", "-o", "ok.pfm", "-q"}).status, 0);
+}
+
+TEST_F(CliTest, ControlCharactersAreEscapedInEveryMessage) {
+    write_bytes(file("esc.xml"), scene_with("Material=\"Grey\"", "Material=\"\x1b[2J\x07\""));
+    const Outcome r = run({"esc.xml", "-o", "x.png"});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.err, "esc.xml:13: Plane: unknown material '\\x1b[2J\\x07'\n");
+    const Outcome name = run({"no\x1b]0;such.xml"});
+    EXPECT_EQ(name.err, "no\\x1b]0;such.xml: cannot open scene: No such file or directory\n");
+    const Outcome option = run({"scene.xml", "--width", "\x1b[31m"});
+    EXPECT_EQ(option.err.find('\x1b'), std::string::npos) << option.err;
+}
+
+TEST_F(CompareCliTest, FoldersAndEndlessFilesNamedLikeImagesExitTwo) {
+    fs::create_directories(file("folder.pfm"));
+    const Outcome folder = run({"compare", "folder.pfm", "quarter.pfm"});
+    EXPECT_EQ(folder.status, 2);
+    EXPECT_EQ(folder.err, "drt compare: folder.pfm: is a folder, not an image file\n");
+    fs::create_symlink("/dev/zero", file("zero.pfm"));
+    const Outcome zero = run({"compare", "quarter.pfm", "zero.pfm"});
+    EXPECT_EQ(zero.status, 2);
+    EXPECT_EQ(zero.err, "drt compare: zero.pfm: not a regular file\n");
+}
+
+// A batch goes on past every kind of failure, in loading or in the render, and ends with its
+// summary: a bad scene, one past the memory budget only once the thread count is known, and one
+// whose allocation fails for want of memory.
+TEST_F(CliTest, BatchGoesOnPastScenesThatFailInLoadingOrRenderingAndPrintsItsSummary) {
+    fs::copy_file(file("scene.xml"), file("a.xml"));
+    write_bytes(file("bad.xml"), scene_with("Radius=\"1\" Material=\"Mirror\"",
+                                            "Radius=\"-1\" Material=\"Mirror\""));
+    // 2^27 pixels at 65536 samples: within every limit of the scene format, but 64 threads
+    // would need 5.8 GiB.
+    write_bytes(file("budget.xml"),
+                scene_with("<Image Width=\"24\" Height=\"16\"/>\n  <Render Samples=\"4\"",
+                           "<Image Width=\"16384\" Height=\"8192\"/>\n  <Render "
+                           "Samples=\"65536\""));
+    fs::copy_file(file("scene.xml"), file("c.xml"));
+    const Outcome r =
+        run({"a.xml", "bad.xml", "budget.xml", "c.xml", "-o", "out/", "-q", "--threads", "64"});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(entries(file("out")), (std::vector<std::string>{"a.png", "c.png"}));
+    EXPECT_NE(r.err.find("bad.xml:14: Sphere: negative radius -1\n"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("drt: budget.xml: the render needs an estimated 5888 MiB (134217728 "
+                         "pixels x 28 B + 64 threads x 65536 samples x 576 B), more than the "
+                         "4096 MiB budget\n"),
+              std::string::npos)
+        << r.err;
+    EXPECT_TRUE(regex_search(r.out,
+                             "\na\\.xml .* ok\nbad\\.xml .* bad input\nbudget\\.xml .* bad "
+                             "input\nc\\.xml .* ok\n$"))
+        << r.out;
+}
+
+#if !defined(__SANITIZE_ADDRESS__)  // ASan reserves terabytes of address space up front
+TEST_F(CliTest, AllocationFailureInARenderFailsThatSceneOnly) {
+    // 8192 x 8192 pixels: within the limits, but its 768 MiB image cannot be had under a 512 MiB
+    // cap on the address space.
+    write_bytes(file("big.xml"),
+                scene_with("Width=\"24\" Height=\"16\"", "Width=\"8192\" Height=\"8192\""));
+    fs::copy_file(file("scene.xml"), file("a.xml"));
+    fs::copy_file(file("scene.xml"), file("c.xml"));
+    const Outcome r =
+        run({"a.xml", "big.xml", "c.xml", "-o", "out/", "-q", "--threads", "2"}, rlim_t{512} << 20);
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_EQ(r.err, "drt: big.xml: out of memory\n");
+    EXPECT_EQ(entries(file("out")), (std::vector<std::string>{"a.png", "c.png"}));
+    EXPECT_TRUE(regex_search(r.out, "\nbig\\.xml .* failed\nc\\.xml .* ok\n$")) << r.out;
+}
+#endif
 
 }  // namespace
 }  // namespace drt

@@ -333,3 +333,69 @@ TEST_F(ImageFileTest, ContentMustMatchTheExtension) {
 
 }  // namespace
 }  // namespace drt
+
+namespace drt {
+namespace {
+
+// What reading `path` fails with, or "read".
+std::string read_error(const fs::path& path) {
+    try {
+        read_image(path);
+    } catch (const ImageError& e) {
+        return e.what();
+    }
+    return "read";
+}
+
+std::string be32(std::uint32_t v) {
+    return {char(v >> 24), char(v >> 16), char(v >> 8), char(v)};
+}
+
+TEST_F(ImageFileTest, PixelLimitIsCheckedFromTheHeaderBeforeDecoding) {
+    const auto pfm = [&](int w, int h) {
+        write_bytes(file("big.pfm"),
+                    "PF\n" + std::to_string(w) + " " + std::to_string(h) + "\n-1.0\n");
+        return read_error(file("big.pfm"));
+    };
+    EXPECT_EQ(pfm(16384, 8192), file("big.pfm").string() + ": truncated PFM data");  // at it
+    EXPECT_EQ(pfm(16385, 8192), file("big.pfm").string() +
+                                    ": image of 16385x8192 pixels exceeds the limit of "
+                                    "134217728 pixels");
+    // A PNG header alone: stb would allocate for the size it gives.
+    const auto png = [&](std::uint32_t w, std::uint32_t h) {
+        write_bytes(file("big.png"), std::string("\x89PNG\r\n\x1a\n", 8) + be32(13) + "IHDR" +
+                                         be32(w) + be32(h) + std::string("\x08\x02\0\0\0", 5) +
+                                         be32(0));
+        return read_error(file("big.png"));
+    };
+    EXPECT_EQ(png(16384, 8192).find("exceeds"), std::string::npos) << png(16384, 8192);
+    EXPECT_EQ(png(16385, 8192), file("big.png").string() +
+                                    ": image of 16385x8192 pixels exceeds the limit of "
+                                    "134217728 pixels");
+}
+
+TEST_F(ImageFileTest, FileSizePastTheLimitIsRefusedBeforeReading) {
+    write_bytes(file("huge.pfm"), "PF\n1 1\n-1.0\n");
+    fs::resize_file(file("huge.pfm"), 12 * (std::uint64_t{1} << 27) + 4096 + 1);  // sparse
+    EXPECT_EQ(read_error(file("huge.pfm")),
+              file("huge.pfm").string() + ": file larger than the 1536 MiB limit for an image");
+}
+
+TEST_F(ImageFileTest, FoldersDevicesAndPipesNamedLikeImagesAreRefused) {
+    fs::create_directories(file("folder.png"));
+    EXPECT_EQ(read_error(file("folder.png")),
+              file("folder.png").string() + ": is a folder, not an image file");
+    fs::create_symlink("/dev/zero", file("zero.pfm"));
+    EXPECT_EQ(read_error(file("zero.pfm")), file("zero.pfm").string() + ": not a regular file");
+    fs::create_symlink("loop.png", file("loop.png"));
+    EXPECT_EQ(read_error(file("loop.png")),
+              file("loop.png").string() + ": cannot open file: Too many levels of symbolic links");
+}
+
+TEST_F(ImageFileTest, ControlCharactersInFileNamesAreEscaped) {
+    EXPECT_EQ(read_error(file("a\x1b[2J.png")),
+              file("a").string() + "\\x1b[2J.png: cannot open file: No such file or directory");
+}
+
+}  // namespace
+}  // namespace drt

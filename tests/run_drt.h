@@ -2,6 +2,7 @@
 #pragma once
 
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -30,11 +31,15 @@ struct Outcome {
 };
 
 // Runs the drt binary with `args` in `cwd`, stdout and stderr captured through files (no pipe to
-// fill up), stdin closed.
-inline Outcome run_drt(const std::vector<std::string>& args, const fs::path& cwd) {
+// fill up), stdin closed. `address_space`, when not 0, caps the child's memory (RLIMIT_AS), so
+// that an allocation fails.
+inline Outcome run_drt(const std::vector<std::string>& args, const fs::path& cwd,
+                       rlim_t address_space = 0) {
     const fs::path out_file = cwd / ".drt_stdout", err_file = cwd / ".drt_stderr";
     const pid_t pid = fork();
     if (pid == 0) {
+        const rlimit cap{address_space, address_space};
+        if (address_space != 0 && setrlimit(RLIMIT_AS, &cap) != 0) _exit(127);
         const int in = open("/dev/null", O_RDONLY);
         const int out = open(out_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
         const int err = open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -49,6 +54,7 @@ inline Outcome run_drt(const std::vector<std::string>& args, const fs::path& cwd
     int wstatus = 0;
     waitpid(pid, &wstatus, 0);
     Outcome r;
+    // -1 for a crash or an abort: no test expects one.
     r.status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1;
     r.out = read_bytes(out_file);
     r.err = read_bytes(err_file);

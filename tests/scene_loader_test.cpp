@@ -849,5 +849,90 @@ TEST_F(SceneFile, ErrorsNameTheFileAsGiven) {
     EXPECT_EQ(error_loading(path), path + ":2: Image: Width must be positive, got 0");
 }
 
+// ---- limits (limits.h) and safe messages -------------------------------------------------------
+
+TEST(SceneLoaderLimits, ImageSidesAtAndPastTheLimit) {
+    EXPECT_EQ(body_error(R"(<Image Width="65536" Height="1"/>)"), "loaded");
+    EXPECT_EQ(body_error(R"(<Image Width="1" Height="65536"/>)"), "loaded");
+    EXPECT_EQ(body_error(R"(<Image Width="65537" Height="1"/>)"),
+              "t.xml:2: Image: Width must be at most 65536, got 65537");
+    EXPECT_EQ(body_error(R"(<Image Width="1" Height="65537"/>)"),
+              "t.xml:2: Image: Height must be at most 65536, got 65537");
+}
+
+TEST(SceneLoaderLimits, PixelCountAtAndPastTheLimit) {
+    EXPECT_EQ(body_error(R"(<Image Width="16384" Height="8192"/>)"), "loaded");
+    EXPECT_EQ(body_error(R"(<Image Width="16385" Height="8192"/>)"),
+              "t.xml:2: Image: image of 16385x8192 pixels exceeds the limit of 134217728 pixels "
+              "(docs/scene-format.md#limits)");
+    // A size given in two elements is checked as a whole.
+    EXPECT_EQ(body_error("<Image Width=\"65536\"/>\n<Image Height=\"2049\"/>"),
+              "t.xml:3: Image: image of 65536x2049 pixels exceeds the limit of 134217728 pixels "
+              "(docs/scene-format.md#limits)");
+}
+
+TEST(SceneLoaderLimits, CountsAtAndPastTheirLimits) {
+    EXPECT_EQ(body_error(R"(<Render Samples="65536" ShadowRays="65536" GlossyRays="65536"
+                                 MaxDepth="512"/>)"),
+              "loaded");
+    EXPECT_EQ(body_error(R"(<Render Samples="65537"/>)"),
+              "t.xml:2: Render: Samples must be at most 65536, got 65537");
+    EXPECT_EQ(body_error(R"(<Render ShadowRays="65537"/>)"),
+              "t.xml:2: Render: ShadowRays must be at most 65536, got 65537");
+    EXPECT_EQ(body_error(R"(<Render GlossyRays="65537"/>)"),
+              "t.xml:2: Render: GlossyRays must be at most 65536, got 65537");
+    EXPECT_EQ(body_error(R"(<Render MaxDepth="513"/>)"),
+              "t.xml:2: Render: MaxDepth must be at most 512, got 513");
+    // Past an int, as before: out of range, not wrapped.
+    EXPECT_EQ(body_error(R"(<Render Samples="2147483648"/>)"),
+              "t.xml:2: Render: attribute 'Samples' is out of range: \"2147483648\"");
+}
+
+TEST(SceneLoaderLimits, SceneFileSizeAtAndPastTheLimit) {
+    const auto dir =
+        std::filesystem::temp_directory_path() / ("drt_loader_limit_" + std::to_string(getpid()));
+    std::filesystem::create_directories(dir);
+    const std::string scene = "<Scene/>";
+    {
+        std::ofstream(dir / "at.xml", std::ios::binary)
+            << scene << std::string((64u << 20) - scene.size(), ' ');
+    }
+    EXPECT_NO_THROW(load_scene(dir / "at.xml"));
+    std::filesystem::resize_file(dir / "at.xml", (64u << 20) + 1);  // one nul byte more
+    try {
+        load_scene(dir / "at.xml");
+        ADD_FAILURE();
+    } catch (const SceneError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  (dir / "at.xml").string() + ": scene file larger than the 64 MiB limit");
+    }
+    std::filesystem::remove_all(dir);
+    // An endless input stops at the limit too.
+    EXPECT_THROW(load_scene("/dev/zero"), SceneError);
+}
+
+TEST(SceneLoaderErrors, ControlCharactersFromTheSceneAreEscapedInMessages) {
+    EXPECT_EQ(body_error("<Gray/>\n<Sphere Px=\"0\" Py=\"0\" Pz=\"0\" Radius=\"1\" "
+                         "Material=\"&#27;]0;owned&#7;\x1b[2J\"/>"),
+              "t.xml:3: Sphere: unknown material '\\x1b]0;owned\\x07\\x1b[2J'");
+    EXPECT_EQ(body_error("<Render Sampler=\"a&#10;b\"/>"),
+              "t.xml:2: Render: unknown sampler 'a\\x0ab'; known: random, stratified, sobol");
+    const auto warnings = warnings_of(
+        "<Image W\xc2\x9b"
+        "dth=\"3\"/>");
+    ASSERT_EQ(warnings.size(), 1u);
+    EXPECT_NE(warnings[0].find("W\\xc2\\x9bdth"), std::string::npos) << warnings[0];
+}
+
+TEST(SceneLoaderErrors, LongValuesAreCutInMessages) {
+    const std::string huge = "-1" + std::string(308, '0');
+    EXPECT_EQ(body_error(std::string(kGray) + "<Light Px=\"0\" Py=\"0\" Pz=\"0\" Radius=\"" + huge +
+                         "\"/>"),
+              "t.xml:2: Light: negative radius -1000000000000000000... (310 characters)");
+    EXPECT_EQ(body_error("<Sphere Px=\"1" + std::string(400, '0') + "\"/>"),
+              "t.xml:2: Sphere: attribute 'Px' is out of range: \"10000000000000000000... (401 "
+              "characters)\"");
+}
+
 }  // namespace
 }  // namespace drt

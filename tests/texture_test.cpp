@@ -292,3 +292,38 @@ TEST(TextureFactory, MakesKnownTexturesAndRejectsUnknownNames) {
 
 }  // namespace
 }  // namespace drt
+
+namespace drt {
+namespace {
+
+// A tiny scale puts points in cells past 2^63, where an integer cell index used to overflow
+// (undefined behaviour the sanitizer build reports). Cells that far are whole multiples of 2^10,
+// so even: the checker shows its first colour.
+TEST(TextureRobustness, TinyScalesAndHugeCoordinatesStayDefined) {
+    const Color a{1, 0, 0}, b{0, 0, 1};
+    const auto checker = make_texture("checker", a, b, 1e-300);
+    for (const Vec3 p : {Vec3{1, 2, 3}, Vec3{-1e10, 5e9, 1e-290}, Vec3{1e308, -1e308, 0}}) {
+        const Color c = checker->value(p);
+        EXPECT_EQ(c.r, a.r) << p.x;
+        EXPECT_EQ(c.b, a.b) << p.x;
+    }
+    // Within range the parity still alternates, including for negative cells.
+    const auto unit = make_texture("checker", a, b, 1);
+    EXPECT_EQ(unit->value({0.5, 0.5, 0.5}).r, a.r);
+    EXPECT_EQ(unit->value({1.5, 0.5, 0.5}).r, b.r);
+    EXPECT_EQ(unit->value({-0.5, 0.5, 0.5}).r, b.r);
+    EXPECT_EQ(unit->value({-0.5, -0.5, 0.5}).r, a.r);
+    for (const double v : {1e19, -1e19, 1e300, -1e300}) {
+        EXPECT_TRUE(std::isfinite(perlin_noise({v, v, v}))) << v;
+    }
+    for (const double v : {1e19, -1e19}) {  // 1e29 in the noise's lattice units
+        EXPECT_TRUE(std::isfinite(make_texture("marble", a, b, 1e-10)->value({v, 1, 2}).r)) << v;
+    }
+    BumpMap bump;
+    bump.scale = 1e-10;
+    const Vec3 n = bump.perturb({0, 0, 1}, {1e10, 3, 4});
+    EXPECT_TRUE(std::isfinite(n.x) && std::isfinite(n.y) && std::isfinite(n.z));
+}
+
+}  // namespace
+}  // namespace drt

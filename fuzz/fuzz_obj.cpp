@@ -1,0 +1,22 @@
+// libFuzzer target: the OBJ reader (a mesh file a scene names).
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include "drt/obj_reader.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    try {
+        const drt::ObjMesh mesh =
+            drt::parse_obj(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.obj");
+        // Every index the reader hands out must point into its arrays.
+        for (const std::uint32_t i : mesh.position_indices) {
+            if (i >= mesh.positions.size()) __builtin_trap();
+        }
+        for (const std::uint32_t i : mesh.normal_indices) {
+            if (i != drt::ObjMesh::kNoNormal && i >= mesh.normals.size()) __builtin_trap();
+        }
+    } catch (const drt::ObjError&) {
+    }
+    return 0;
+}

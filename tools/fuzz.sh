@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (clang, ASan + UBSan) in build-fuzz/ and runs one of them.
+# Usage: tools/fuzz.sh TARGET [SECONDS]     TARGET: scene, image, cli or obj; default 60 seconds
+#        tools/fuzz.sh --build               only build
+# The corpus grows in build-fuzz/corpus/TARGET, seeded from fuzz/corpus/TARGET (scene: scenes/).
+# A crash leaves build-fuzz/crash-TARGET-* and makes the script fail: turn it into a regression
+# test in the normal suite (docs/testing.md).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)  # absolute paths throughout: the cli target changes its working folder
+target=${1:?usage: tools/fuzz.sh scene|image|cli|obj [SECONDS] | --build}
+seconds=${2:-60}
+
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+    -DDRT_FUZZ=ON -DDRT_BUILD_TESTS=OFF -DDRT_PORTABLE=ON "${launcher[@]}" >/dev/null
+cmake --build build-fuzz -j"$(nproc)" -- --quiet 2>&1 | grep -E "error" || true
+[ "$target" = --build ] && exit 0
+
+binary=$root/build-fuzz/fuzz/fuzz_$target
+[ -x "$binary" ] || { echo "fuzz.sh: no target '$target' (scene, image, cli, obj)" >&2; exit 2; }
+corpus=$root/build-fuzz/corpus/$target
+mkdir -p "$corpus"
+if [ "$target" = scene ]; then
+    cp -n scenes/*.xml scenes/*/*.xml "$corpus"/ 2>/dev/null || true
+    dict=$root/fuzz/scene.dict
+else
+    cp -n fuzz/corpus/"$target"/* "$corpus"/ 2>/dev/null || true
+    dict=$root/fuzz/$target.dict
+fi
+[ -f "$dict" ] || dict=
+# -rss_limit_mb: above the largest allocation the limits allow, below what would trouble CI.
+# -timeout: no input may take this long (the targets keep renders tiny).
+"$binary" "$corpus" ${dict:+-dict="$dict"} -max_total_time="$seconds" -rss_limit_mb=4096 \
+    -timeout=30 -print_final_stats=1 -artifact_prefix="$root/build-fuzz/crash-$target-" 2>&1 |
+    grep -E "^(#[0-9]+ *DONE|Done|stat::number_of_executed_units|stat::new_units_added)|ERROR|SUMMARY|Test unit written|crash-|timeout-|oom-|leak-|slow-unit" || true
+# libFuzzer's own exit status is lost in the pipe; an artefact is the verdict.
+if compgen -G "build-fuzz/crash-$target-*" >/dev/null; then
+    echo "fuzz.sh: $target found a failure: $(ls build-fuzz/crash-"$target"-*)" >&2
+    exit 1
+fi
+echo "fuzz.sh: $target: no failure in ${seconds} s"
