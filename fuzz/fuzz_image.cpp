@@ -28,7 +28,7 @@ const std::filesystem::path& folder() {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     if (size < 1) return 0;
-    static const char* const kExtensions[] = {".pfm", ".png", ".bmp"};
+    static const char* const kExtensions[] = {".pfm", ".png", ".bmp", ".exr"};
     const std::filesystem::path file =
         folder() / (std::string("input") + kExtensions[data[0] % std::size(kExtensions)]);
     {

@@ -11,11 +11,15 @@ root=$(pwd)  # absolute paths throughout: the cli target changes its working fol
 target=${1:?usage: tools/fuzz.sh scene|image|cli|obj [SECONDS] | --build}
 seconds=${2:-60}
 
-launcher=()
-command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
-    -DDRT_FUZZ=ON -DDRT_BUILD_TESTS=OFF -DDRT_PORTABLE=ON "${launcher[@]}" >/dev/null
-cmake --build build-fuzz -j"$(nproc)" -- --quiet 2>&1 | grep -E "error" || true
+# DRT_FUZZ_BUILT=1 skips the build step (tools/test.sh builds once, then runs targets side by side).
+if [ "${DRT_FUZZ_BUILT:-0}" != 1 ]; then
+    launcher=()
+    command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+    cxx=$(command -v clang++-14 || command -v clang++)
+    cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER="$cxx" \
+        -DDRT_FUZZ=ON -DDRT_BUILD_TESTS=OFF -DDRT_PORTABLE=ON "${launcher[@]}" >/dev/null
+    cmake --build build-fuzz -j"$(nproc)" >/dev/null
+fi
 [ "$target" = --build ] && exit 0
 
 binary=$root/build-fuzz/fuzz/fuzz_$target

@@ -6,7 +6,7 @@
 set -euo pipefail
 
 packages=(g++ cmake make pkg-config libtinyxml2-dev libstb-dev libcli11-dev libopenexr-dev
-          libgtest-dev openexr)
+          libgtest-dev openexr clang-14 libclang-rt-14-dev)
 for arg in "$@"; do
     case "$arg" in
         --study) packages+=(gnuplot-nox) ;;
