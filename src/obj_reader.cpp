@@ -4,6 +4,8 @@
 // (README.md, Dependencies).
 #include "drt/obj_reader.h"
 
+#include <sys/stat.h>
+
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -11,6 +13,7 @@
 #include <memory>
 #include <system_error>
 
+#include "drt/limits.h"
 #include "drt/text.h"
 
 namespace drt {
@@ -189,10 +192,24 @@ std::string read_text(const std::filesystem::path& path) {
     const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
                                                                &std::fclose);
     if (!file) throw cannot_open(errno);
+    const auto too_large = [&] {
+        return ObjError(printable(path.string()) + ": file larger than the " +
+                        std::to_string(kMaxObjBytes >> 20) + " MiB limit for a mesh");
+    };
+    // A regular file's size is known before reading; an endless input (/dev/zero) is caught as
+    // it is read.
+    struct stat info {};
+    if (::fstat(::fileno(file.get()), &info) == 0 && S_ISREG(info.st_mode) &&
+        static_cast<std::uint64_t>(info.st_size) > kMaxObjBytes) {
+        throw too_large();
+    }
     std::string contents;
     char buffer[1 << 16];
     std::size_t n = 0;
-    while ((n = std::fread(buffer, 1, sizeof buffer, file.get())) > 0) contents.append(buffer, n);
+    while ((n = std::fread(buffer, 1, sizeof buffer, file.get())) > 0) {
+        if (contents.size() + n > kMaxObjBytes) throw too_large();
+        contents.append(buffer, n);
+    }
     // A directory opens fine on Linux and fails only when read (EISDIR).
     if (std::ferror(file.get())) throw cannot_open(errno);
     return contents;

@@ -12,22 +12,15 @@
 #include <functional>
 #include <string>
 
+#include "temp_folder.h"
+
 namespace drt {
 namespace {
 
 namespace fs = std::filesystem;
 
-class InterruptTest : public ::testing::Test {
+class InterruptTest : public test::TempFolderTest {
   protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() /
-               ("drt_interrupt_test_" + std::to_string(getpid()) + "_" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-
     // The child's wait status after running `body` (exit 0 when body returns).
     static int in_child(const std::function<void()>& body) {
         const pid_t pid = fork();
@@ -39,8 +32,6 @@ class InterruptTest : public ::testing::Test {
         waitpid(pid, &status, 0);
         return status;
     }
-
-    fs::path dir_;
 };
 
 TEST_F(InterruptTest, SignalRemovesRegisteredTemporariesAndEndsTheProcessAsTheSignalWould) {

@@ -1,7 +1,11 @@
 #include "drt/obj_reader.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -134,6 +138,21 @@ TEST(ObjReader, NamesAFileThatCannotBeOpened) {
         EXPECT_STREQ(e.what(), "No such file or directory");
     }
     EXPECT_THROW(read_obj("/"), ObjOpenError);  // a folder
+}
+
+TEST(ObjReader, FileSizePastTheLimitIsRefusedBeforeReading) {
+    const auto path = std::filesystem::temp_directory_path() /
+                      ("drt_obj_limit_" + std::to_string(::getpid()) + ".obj");
+    { std::ofstream(path) << "v 0 0 0\n"; }
+    std::filesystem::resize_file(path, (std::uint64_t{1} << 30) + 1);  // sparse: nothing is read
+    try {
+        read_obj(path);
+        ADD_FAILURE() << "read a file past the limit";
+    } catch (const ObjError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  path.string() + ": file larger than the 1024 MiB limit for a mesh");
+    }
+    std::filesystem::remove(path);
 }
 
 }  // namespace

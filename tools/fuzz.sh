@@ -18,7 +18,12 @@ if [ "${DRT_FUZZ_BUILT:-0}" != 1 ]; then
     cxx=$(command -v clang++-14 || command -v clang++)
     cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER="$cxx" \
         -DDRT_FUZZ=ON -DDRT_BUILD_TESTS=OFF -DDRT_PORTABLE=ON "${launcher[@]}" >/dev/null
-    cmake --build build-fuzz -j"$(nproc)" >/dev/null
+    # Quiet unless it fails (clang warns about other things than g++ does).
+    if ! log=$(cmake --build build-fuzz -j"$(nproc)" 2>&1); then
+        grep -E "error" <<<"$log" >&2 || tail -20 <<<"$log" >&2
+        echo "fuzz.sh: build failed" >&2
+        exit 1
+    fi
 fi
 [ "$target" = --build ] && exit 0
 

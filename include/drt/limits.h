@@ -46,6 +46,9 @@ inline constexpr int kMaxThreads = 1024;
 // A scene file larger than this is refused before it is parsed (the XML tree takes several
 // times the text).
 inline constexpr std::uint64_t kMaxSceneBytes = std::uint64_t{64} << 20;  // 64 MiB
+// An OBJ file larger than this is refused while reading: 1 GiB of text holds about 30 million
+// vertices and twice as many triangles, whose 59 bytes each (mesh.h) already fill the budget.
+inline constexpr std::uint64_t kMaxObjBytes = std::uint64_t{1} << 30;
 // An image file larger than this is refused while reading: a .pfm of kMaxPixels with its header.
 inline constexpr std::uint64_t kMaxImageFileBytes = 12 * kMaxPixels + 4096;
 
