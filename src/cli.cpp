@@ -15,14 +15,20 @@
 #include <new>
 #include <optional>
 #include <sstream>
+#include <stop_token>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "drt/atomic_file.h"
+#include "drt/checkpoint.h"
 #include "drt/compare.h"
 #include "drt/converge.h"
 #include "drt/image.h"
+#include "drt/interrupt.h"
 #include "drt/limits.h"
+#include "drt/mpi_work.h"
+#include "drt/render_job.h"
 #include "drt/render_plan.h"
 #include "drt/renderer.h"
 #include "drt/sampler.h"
@@ -38,6 +44,8 @@ namespace {
 constexpr int kOk = 0;
 constexpr int kFailed = 1;
 constexpr int kBadInput = 2;
+// A render stopped by SIGINT (or by --stop-after-tiles, which stands for one): 128 + 2.
+constexpr int kInterrupted = 130;
 
 // A setting past one of the limits of limits.h once the options are applied: bad input.
 class LimitError : public std::runtime_error {
@@ -215,7 +223,7 @@ std::string stats_json(const Scene& scene, const RenderResult& r) {
       << "  \"shadow_rays\": " << s.shadow_rays << ", \"glossy_rays\": " << s.glossy_rays
       << ", \"max_depth\": " << s.max_depth << ", \"seed\": " << s.seed
       << ", \"sampler\": " << json_string(s.sampler) << ", \"threads\": " << r.stats.threads
-      << ",\n"
+      << ", \"processes\": " << r.stats.processes << ",\n"
       << "  \"rays\": {\"camera\": " << rays.camera << ", \"shadow\": " << rays.shadow
       << ", \"reflection\": " << rays.reflection << ", \"refraction\": " << rays.refraction
       << ", \"total\": " << rays.total() << "},\n"
@@ -280,6 +288,15 @@ struct RenderJob {
     bool quiet = false;
     bool progress = false;
     bool exr_half = false;
+    std::string checkpoint;  // a file, or with several scenes a folder of <scene>.checkpoint
+    double checkpoint_seconds = 30;
+    std::optional<std::size_t> stop_after_tiles;
+    std::stop_token stop;
+    const MpiJob* mpi = nullptr;
+
+    bool leader() const { return mpi == nullptr || mpi->leader(); }
+    // Under MPI: the highest status of all processes, so that all exit alike.
+    int agree(int status) const { return mpi ? mpi->highest(status) : status; }
 };
 
 // What an .exr header records about the render, so that the file says how it was made. The
@@ -308,74 +325,154 @@ std::size_t count_nonfinite(const Image& image) {
                                                   [](float v) { return !std::isfinite(v); }));
 }
 
+// Turns a signal (interrupt.h) into a stop request for the render in progress. The handler may
+// only set a flag, so it is polled here; a second signal still ends drt at once.
+class SignalStop {
+  public:
+    SignalStop()
+        : poller_([this](std::stop_token done) {
+              while (!done.stop_requested()) {
+                  if (stop_signal().load() != 0) {
+                      source_.request_stop();
+                      return;
+                  }
+                  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+              }
+          }) {}
+    std::stop_token token() const { return source_.get_token(); }
+
+  private:
+    CooperativeStop cooperative_;
+    std::stop_source source_;
+    std::jthread poller_;  // last: stopped and joined before the rest goes
+};
+
+// `<stem>.partial.<ext>` beside the output: an interrupted render's finished tiles.
+fs::path partial_path(const fs::path& output) {
+    return output.parent_path() /
+           (output.stem().string() + ".partial" + output.extension().string());
+}
+
+// Runs `step`, turning every exception into a message and a status.
+template <typename Step>
+int guarded(const std::string& name, std::ostream& err, Step&& step) {
+    try {
+        step();
+        return kOk;
+    } catch (const SceneError& e) {
+        err << e.what() << "\n";
+    } catch (const ImageError& e) {
+        err << "drt: " << e.what() << "\n";
+    } catch (const CheckpointError& e) {
+        err << "drt: " << printable(e.what()) << "\n";
+    } catch (const LimitError& e) {
+        err << "drt: " << name << ": " << e.what() << "\n";
+    } catch (const std::bad_alloc&) {
+        err << "drt: " << name << ": out of memory\n";
+        return kFailed;
+    } catch (const std::exception& e) {
+        err << "drt: " << name << ": " << printable(e.what()) << "\n";
+        return kFailed;
+    }
+    return kBadInput;
+}
+
 // One scene, start to end. Everything that can go wrong ends here as a message and a status, so
-// that a batch goes on with its other scenes: this is the job boundary.
-SceneOutcome render_one(const std::string& scene_path, const fs::path& output, const RenderJob& job,
+// that a batch goes on with its other scenes: this is the job boundary. Under MPI every process
+// runs it, and all agree on the status after each step, so that none waits for another that
+// gave up.
+SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
+                        const std::optional<fs::path>& checkpoint, const RenderJob& job,
                         std::ostream& err) {
     SceneOutcome outcome;
     outcome.scene = scene_path;
     const std::string name = printable(scene_path);
-    try {
+    std::optional<LoadedScene> loaded;
+    int status = guarded(name, err, [&] {
         format_for_path(output);  // refuse an unknown extension before spending time rendering
-        LoadedScene loaded = load_scene(scene_path);
-        for (const std::string& w : loaded.warnings) err << w << "\n";
-        Scene& scene = loaded.scene;
-        job.overrides.apply(scene.settings);
-        if (const auto problem = render_limit_problem(scene.settings, job.threads)) {
+        loaded.emplace(load_scene(scene_path));
+        for (const std::string& w : loaded->warnings) err << w << "\n";
+        job.overrides.apply(loaded->scene.settings);
+        if (const auto problem = render_limit_problem(loaded->scene.settings, job.threads)) {
             throw LimitError(*problem);
         }
-        RenderOptions options;
-        options.threads = job.threads;
-        options.adaptive = job.adaptive.settings();
-        std::optional<ProgressDisplay> display;
-        if (job.progress) {
-            display.emplace(err, printable(fs::path(scene_path).filename().string()));
-            options.on_progress = [&](double done) { (*display)(done); };
-        }
-        const RenderResult result = render(scene, options);
-        outcome.width = scene.settings.width;
-        outcome.height = scene.settings.height;
-        outcome.samples = scene.settings.samples;
-        outcome.seconds = result.stats.seconds;
-        outcome.mrays_per_second =
-            result.stats.seconds > 0 ? result.stats.rays.total() / result.stats.seconds / 1e6 : 0;
-        outcome.json = stats_json(scene, result);
-        try {
-            write_image(result.image, output, output_options(scene, result, job));
-        } catch (const ImageError& e) {
-            err << "drt: " << e.what() << "\n";
-            outcome.status = kFailed;
-            return outcome;
-        }
-        if (!job.quiet) {
-            err << "drt: wrote " << printable(output.string()) << " (" << outcome.width << "x"
-                << outcome.height << ", " << outcome.samples << " spp, " << std::fixed
-                << std::setprecision(2) << outcome.seconds << " s)\n"
-                << std::defaultfloat;
-        }
-        // Written all the same, for inspection, but not a success: no pixel may be silently lost.
-        if (const std::size_t bad = count_nonfinite(result.image)) {
-            err << "drt: " << name << ": " << bad << " of " << result.image.rgb.size()
-                << " channel values are not finite (radiance beyond the float range: a light, "
-                   "background or ambient too bright?)\n";
-            outcome.status = kBadInput;
-        }
-    } catch (const SceneError& e) {
-        err << e.what() << "\n";
-        outcome.status = kBadInput;
+    });
+    if (const int agreed = job.agree(status); agreed != kOk) {
+        if (status == kOk) err << "drt: " << name << ": failed in another process\n";
+        outcome.status = agreed;
+        return outcome;
+    }
+    const Scene& scene = loaded->scene;
+    RenderJobOptions options;
+    options.threads = job.threads;
+    options.adaptive = job.adaptive.settings();
+    options.checkpoint = checkpoint;
+    options.scene_files = {scene_path};
+    options.checkpoint_interval = std::chrono::duration<double>(job.checkpoint_seconds);
+    options.stop_after_tiles = job.stop_after_tiles;
+    options.stop = job.stop;
+    options.mpi = job.mpi;
+    std::optional<ProgressDisplay> display;
+    if (job.progress && job.leader()) {
+        display.emplace(err, printable(fs::path(scene_path).filename().string()));
+        options.on_progress = [&](double done) { (*display)(done); };
+    }
+    RenderJobResult r;
+    status = guarded(name, err, [&] { r = run_render_job(scene, options); });
+    if (status != kOk || !job.leader()) {
+        outcome.status = job.agree(status);
+        return outcome;
+    }
+    const RenderResult& result = r.render;
+    outcome.width = scene.settings.width;
+    outcome.height = scene.settings.height;
+    outcome.samples = scene.settings.samples;
+    outcome.seconds = result.stats.seconds;
+    outcome.mrays_per_second =
+        result.stats.seconds > 0 ? result.stats.rays.total() / result.stats.seconds / 1e6 : 0;
+    const fs::path target = r.complete() ? output : partial_path(output);
+    try {
+        write_image(result.image, target, output_options(scene, result, job));
     } catch (const ImageError& e) {
         err << "drt: " << e.what() << "\n";
-        outcome.status = kBadInput;
-    } catch (const LimitError& e) {
-        err << "drt: " << name << ": " << e.what() << "\n";
-        outcome.status = kBadInput;
-    } catch (const std::bad_alloc&) {
-        err << "drt: " << name << ": out of memory\n";
-        outcome.status = kFailed;
-    } catch (const std::exception& e) {
-        err << "drt: " << name << ": " << printable(e.what()) << "\n";
-        outcome.status = kFailed;
+        outcome.status = job.agree(kFailed);
+        return outcome;
     }
+    if (!r.complete()) {
+        const int sig = stop_signal().load();
+        err << "drt: " << name << ": interrupted with " << r.done << " of " << r.tiles
+            << " tiles done; wrote " << printable(target.string());
+        if (checkpoint) {
+            err << " and " << printable(checkpoint->string())
+                << "\ndrt: run the same command again to resume\n";
+        } else {
+            err << "\ndrt: with --checkpoint FILE an interrupted render can be resumed\n";
+        }
+        outcome.status = job.agree(sig != 0 ? 128 + sig : kInterrupted);
+        return outcome;
+    }
+    outcome.json = stats_json(scene, result);
+    if (checkpoint) {
+        std::error_code ignored;
+        fs::remove(*checkpoint, ignored);
+        // What an earlier, interrupted run left is superseded by the image.
+        if (r.resumed > 0) fs::remove(partial_path(output), ignored);
+    }
+    if (!job.quiet) {
+        err << "drt: wrote " << printable(output.string()) << " (" << outcome.width << "x"
+            << outcome.height << ", " << outcome.samples << " spp, " << std::fixed
+            << std::setprecision(2) << outcome.seconds << " s";
+        if (r.resumed > 0) err << ", " << r.resumed << " of " << r.tiles << " tiles resumed";
+        err << ")\n" << std::defaultfloat;
+    }
+    // Written all the same, for inspection, but not a success: no pixel may be silently lost.
+    if (const std::size_t bad = count_nonfinite(result.image)) {
+        err << "drt: " << name << ": " << bad << " of " << result.image.rgb.size()
+            << " channel values are not finite (radiance beyond the float range: a light, "
+               "background or ambient too bright?)\n";
+        status = kBadInput;
+    }
+    outcome.status = job.agree(status);
     return outcome;
 }
 
@@ -403,7 +500,8 @@ bool is_folder_target(const std::string& output) {
     return !output.empty() && (output.back() == '/' || fs::is_directory(output, ignored));
 }
 
-int render_command(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+int render_command(int argc, const char* const* argv, std::ostream& out, std::ostream& err,
+                   const MpiJob* mpi) {
     CLI::App app{
         "drt: distributed ray tracer (Cook, Porter & Carpenter 1984).\n"
         "Also: drt compare A B [--max-rmse X] [--diff D.png] | drt info SCENE.xml | "
@@ -425,6 +523,14 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
     app.add_option("--stats", stats, "Write render statistics as JSON to FILE (- = stdout)");
     app.add_flag("-q,--quiet", job.quiet, "No progress display or messages besides errors");
     app.add_flag("--progress", force_progress, "Show progress even when stderr is not a terminal");
+    app.add_option("--checkpoint", job.checkpoint,
+                   "Keep finished work in FILE (with several scenes, a folder); running the same "
+                   "command again resumes from it; removed when the render completes");
+    app.add_option("--checkpoint-every", job.checkpoint_seconds,
+                   "Seconds between checkpoint writes (default 30)")
+        ->check(CLI::NonNegativeNumber);
+    // For tests: stop as SIGINT would once N tiles are done.
+    app.add_option("--stop-after-tiles", job.stop_after_tiles)->group("");
     app.set_version_flag("--version", std::string("drt ") + DRT_VERSION);
     try {
         app.parse(argc, argv);
@@ -439,37 +545,54 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
         return kBadInput;
     }
     // Before any image replaces its output, so that a run never ends half done for want of it.
-    if (!stats.empty() && stats != "-") {
+    job.mpi = mpi;
+    if (!stats.empty() && stats != "-" && job.leader()) {
         try {
             check_replaceable(stats);
         } catch (const FileWriteError& e) {
             err << "drt: --stats " << e.what() << "\n";
-            return kBadInput;
+            return job.agree(kBadInput);
         }
     }
+    if (job.agree(kOk) != kOk) return kBadInput;
     job.progress = !job.quiet && (force_progress || isatty(STDERR_FILENO));
 
     const bool batch = scenes.size() > 1 || is_folder_target(output);
+    int made = kOk;
+    if (job.leader()) {
+        for (const std::string& folder : {batch ? output : "", batch ? job.checkpoint : ""}) {
+            if (folder.empty()) continue;
+            std::error_code ec;
+            fs::create_directories(folder, ec);
+            if (ec) {
+                err << "drt: " << printable(folder) << ": cannot create folder: " << ec.message()
+                    << "\n";
+                made = kFailed;
+            }
+        }
+    }
+    if (job.agree(made) != kOk) return kFailed;
+    const SignalStop signals;
+    job.stop = signals.token();
     std::vector<SceneOutcome> outcomes;
     for (const std::string& scene : scenes) {
         fs::path target = fs::path(scene).stem().string() + ".png";
-        if (batch && !output.empty()) {
-            std::error_code ec;
-            fs::create_directories(output, ec);
-            if (ec) {
-                err << "drt: " << printable(output) << ": cannot create folder: " << ec.message()
-                    << "\n";
-                return kFailed;
-            }
-            target = fs::path(output) / target;
+        std::optional<fs::path> checkpoint;
+        if (!job.checkpoint.empty()) checkpoint = job.checkpoint;
+        if (batch) {
+            if (!output.empty()) target = fs::path(output) / target;
+            if (checkpoint) *checkpoint /= fs::path(scene).stem().string() + ".checkpoint";
         } else if (!output.empty()) {
             target = output;
         }
-        outcomes.push_back(render_one(scene, target, job, err));
+        outcomes.push_back(render_one(scene, target, checkpoint, job, err));
+        // An interrupt ends the batch: the scenes after it are not started.
+        if (outcomes.back().status > kBadInput) break;
     }
 
     int status = kOk;
     for (const SceneOutcome& o : outcomes) status = std::max(status, o.status);
+    if (!job.leader()) return status;  // the leader reports for all
     if (!stats.empty()) {
         std::string json;
         if (!batch) {
@@ -742,7 +865,8 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
 
 }  // namespace
 
-int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& err,
+            const MpiJob* mpi) {
     // The last guard: every command catches what it expects, and nothing may end in an abort.
     try {
         if (argc >= 2) {
@@ -752,7 +876,7 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
             if (command == "info") return info_command(argc - 1, argv + 1, out, err);
             if (command == "converge") return converge_command(argc - 1, argv + 1, out, err);
         }
-        return render_command(argc, argv, out, err);
+        return render_command(argc, argv, out, err, mpi);
     } catch (const std::bad_alloc&) {
         err << "drt: out of memory\n";
     } catch (const std::exception& e) {

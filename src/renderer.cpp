@@ -91,8 +91,15 @@ RenderResult render(const RenderContext& context, ImageSink& sink, const RenderO
             options.on_progress(before + share * done);
         };
     }
+    const int threads = render_tiles(context, source, sink, run);
+    RenderResult result = assembled(context, sink);
+    result.stats.threads = threads;
+    result.stats.seconds = seconds_since(start);
+    return result;
+}
+
+RenderResult assembled(const RenderContext& context, const ImageSink& sink) {
     RenderResult result;
-    result.stats.threads = render_tiles(context, source, sink, run);
     result.image = sink.image();
     result.plan = context.plan();
     result.stats.adaptive = context.adaptive();
@@ -101,7 +108,6 @@ RenderResult render(const RenderContext& context, ImageSink& sink, const RenderO
     result.stats.samples = sink.samples();
     result.stats.pixels_converged = sink.converged();
     result.unfinished = sink.missing();
-    result.stats.seconds = seconds_since(start);
     return result;
 }
 

@@ -31,7 +31,8 @@ struct RenderOptions {
 
 struct RenderStats {
     double seconds = 0;
-    int threads = 1;
+    int threads = 1;    // worker threads of one process
+    int processes = 1;  // processes of an MPI job (mpi_work.h)
     RayCounts rays;
     std::uint64_t samples = 0;           // camera samples taken over all pixels
     std::uint64_t pixels_converged = 0;  // adaptive: pixels that stopped before the maximum
@@ -56,6 +57,10 @@ RenderResult render(const Scene& scene, const RenderOptions& options);
 // tiles finished earlier (added to the sink first) gives the same bits as one never stopped.
 // options.adaptive is ignored: the context's applies.
 RenderResult render(const RenderContext& context, ImageSink& sink, const RenderOptions& options);
+
+// What the tiles in `sink` make: the image, the per-pixel sample counts, the totals and the
+// tiles still missing (stats.seconds and stats.threads are left for the caller).
+RenderResult assembled(const RenderContext& context, const ImageSink& sink);
 
 // Renders tiles from `source` on options.threads workers (capped at source.size()) into `sink`
 // until the source runs dry or a stop is requested. An exception in a worker (from the source,

@@ -1,0 +1,117 @@
+#include "drt/render_job.h"
+
+#include <atomic>
+#include <chrono>
+#include <string>
+
+#include "drt/atomic_file.h"
+#include "drt/checkpoint.h"
+#include "drt/render_context.h"
+#include "drt/tile.h"
+
+namespace drt {
+
+namespace {
+
+// Requests a stop once `limit` tiles are done, counting those the sink had before.
+class StopAfter final : public TileSink {
+  public:
+    StopAfter(TileSink& next, std::size_t done, std::size_t limit, std::stop_source stop)
+        : next_(next), done_(done), limit_(limit), stop_(std::move(stop)) {
+        if (done_ >= limit_) stop_.request_stop();
+    }
+    void add(TileBuffer buffer) override {
+        next_.add(std::move(buffer));
+        if (done_.fetch_add(1) + 1 >= limit_) stop_.request_stop();
+    }
+
+  private:
+    TileSink& next_;
+    std::atomic<std::size_t> done_;
+    std::size_t limit_;
+    std::stop_source stop_;
+};
+
+}  // namespace
+
+RenderJobResult run_render_job(const Scene& scene, const RenderJobOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
+    const RenderContext context(scene, options.adaptive);
+    const bool leader = options.mpi == nullptr || options.mpi->leader();
+    RenderJobResult out;
+    out.tiles = context.tiles().size();
+
+    // Only the leader assembles the image and keeps the checkpoint.
+    std::optional<ImageSink> image;
+    std::optional<CheckpointSink> kept;
+    std::string refused;
+    if (leader) {
+        image.emplace(scene.settings.width, scene.settings.height, context.tiles());
+        if (options.checkpoint) {
+            try {
+                const RenderIdentity id = identify_render(options.scene_files, scene.settings,
+                                                          context.adaptive(), out.tiles);
+                try {
+                    check_replaceable(*options.checkpoint);
+                } catch (const FileWriteError& e) {
+                    throw CheckpointError(e.what());
+                }
+                std::optional<Checkpoint> resumed =
+                    read_checkpoint(*options.checkpoint, id, context.tiles());
+                if (resumed) out.resumed = resumed->tiles.size();
+                kept.emplace(*image, *options.checkpoint, id, options.checkpoint_interval,
+                             resumed ? std::move(resumed->tiles) : std::vector<TileBuffer>{});
+            } catch (const CheckpointError& e) {
+                refused = e.what();
+            }
+        }
+    }
+    const bool refuse =
+        options.mpi ? options.mpi->leaders(refused.empty() ? 0 : 1) != 0 : !refused.empty();
+    if (refuse) throw CheckpointError(leader ? refused : "the leader refused the checkpoint");
+
+    std::stop_source stopper;
+    const std::stop_callback relay(options.stop, [&] { stopper.request_stop(); });
+    std::optional<StopAfter> stop_after;
+    TileSink* into = nullptr;
+    std::vector<Tile> todo;
+    RenderOptions run;
+    run.threads = options.threads;
+    run.stop = stopper.get_token();
+    if (leader) {
+        into = kept ? static_cast<TileSink*>(&*kept) : &*image;
+        if (options.stop_after_tiles) {
+            into =
+                &stop_after.emplace(*into, image->tiles_done(), *options.stop_after_tiles, stopper);
+        }
+        todo = image->missing();
+        if (options.on_progress) {
+            run.on_progress = [&](double) {
+                options.on_progress(double(image->tiles_done()) / double(image->tile_count()));
+            };
+        }
+    }
+    int threads = 0;
+    if (options.mpi) {
+        // Elsewhere than on the leader, tiles go to the leader instead of a sink.
+        ImageSink unused(0, 0, {});
+        threads = options.mpi->render(context, std::move(todo), into ? *into : unused, run);
+    } else {
+        TileQueue queue(std::move(todo));
+        threads = render_tiles(context, queue, *into, run);
+    }
+    if (!leader) {
+        out.done = out.tiles;
+        return out;
+    }
+    out.render = assembled(context, *image);
+    out.done = image->tiles_done();
+    out.render.stats.threads = threads;
+    out.render.stats.processes = options.mpi ? options.mpi->size() : 1;
+    if (kept && !out.complete()) kept->write();
+    out.render.stats.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return out;
+}
+
+}  // namespace drt
