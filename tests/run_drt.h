@@ -1,4 +1,5 @@
-// Running the built drt binary as a user does, and the file helpers its tests share.
+// Running the built drt binary (or mpirun with it) as a user does, and the file helpers its
+// tests share.
 #pragma once
 
 #include <fcntl.h>
@@ -26,15 +27,21 @@ inline void write_bytes(const fs::path& path, const std::string& bytes) {
 }
 
 struct Outcome {
-    int status = -1;
+    int status = -1;  // the exit status, or 128 + the signal that ended the process
     std::string out, err;
 };
 
+<<<<<<< HEAD
 // Runs the drt binary with `args` in `cwd`, stdout and stderr captured through files (no pipe to
 // fill up), stdin closed. `address_space`, when not 0, caps the child's memory (RLIMIT_AS), so
 // that an allocation fails.
 inline Outcome run_drt(const std::vector<std::string>& args, const fs::path& cwd,
                        rlim_t address_space = 0) {
+=======
+// Starts `argv` (argv[0] looked up in PATH) in `cwd`, stdout and stderr going to files there (no
+// pipe to fill up), stdin closed; returns its process id for finish_process.
+inline pid_t start_process(const std::vector<std::string>& argv, const fs::path& cwd) {
+>>>>>>> 36bc613 (Scale-out tests share tests/run_drt.h (process start/finish, mpirun); resumed-render and MPI stop tests made independent of timing; usage doc: checkpoints, interrupts, MPI with a hostfile example)
     const fs::path out_file = cwd / ".drt_stdout", err_file = cwd / ".drt_stderr";
     const pid_t pid = fork();
     if (pid == 0) {
@@ -45,22 +52,45 @@ inline Outcome run_drt(const std::vector<std::string>& args, const fs::path& cwd
         const int err = open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
         if (in < 0 || out < 0 || err < 0 || chdir(cwd.c_str()) != 0) _exit(127);
         dup2(in, 0), dup2(out, 1), dup2(err, 2);
-        std::vector<char*> argv{const_cast<char*>(DRT_BINARY)};
-        for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-        argv.push_back(nullptr);
-        execv(DRT_BINARY, argv.data());
+        std::vector<char*> args;
+        for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+        args.push_back(nullptr);
+        execvp(args[0], args.data());
         _exit(127);
     }
+    return pid;
+}
+
+// Waits for a process from start_process and collects what it printed.
+inline Outcome finish_process(pid_t pid, const fs::path& cwd) {
     int wstatus = 0;
     waitpid(pid, &wstatus, 0);
     Outcome r;
+<<<<<<< HEAD
     // -1 for a crash or an abort: no test expects one.
     r.status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1;
+=======
+    r.status = WIFEXITED(wstatus)     ? WEXITSTATUS(wstatus)
+               : WIFSIGNALED(wstatus) ? 128 + WTERMSIG(wstatus)
+                                      : -1;
+    const fs::path out_file = cwd / ".drt_stdout", err_file = cwd / ".drt_stderr";
+>>>>>>> 36bc613 (Scale-out tests share tests/run_drt.h (process start/finish, mpirun); resumed-render and MPI stop tests made independent of timing; usage doc: checkpoints, interrupts, MPI with a hostfile example)
     r.out = read_bytes(out_file);
     r.err = read_bytes(err_file);
     fs::remove(out_file);
     fs::remove(err_file);
     return r;
+}
+
+inline Outcome run_process(const std::vector<std::string>& argv, const fs::path& cwd) {
+    return finish_process(start_process(argv, cwd), cwd);
+}
+
+// Runs the drt binary with `args` in `cwd`.
+inline Outcome run_drt(const std::vector<std::string>& args, const fs::path& cwd) {
+    std::vector<std::string> argv{DRT_BINARY};
+    argv.insert(argv.end(), args.begin(), args.end());
+    return run_process(argv, cwd);
 }
 
 }  // namespace drt::test
