@@ -27,21 +27,15 @@ inline void write_bytes(const fs::path& path, const std::string& bytes) {
 }
 
 struct Outcome {
-    int status = -1;  // the exit status, or 128 + the signal that ended the process
+    int status = -1;
     std::string out, err;
 };
 
-<<<<<<< HEAD
-// Runs the drt binary with `args` in `cwd`, stdout and stderr captured through files (no pipe to
-// fill up), stdin closed. `address_space`, when not 0, caps the child's memory (RLIMIT_AS), so
-// that an allocation fails.
-inline Outcome run_drt(const std::vector<std::string>& args, const fs::path& cwd,
-                       rlim_t address_space = 0) {
-=======
 // Starts `argv` (argv[0] looked up in PATH) in `cwd`, stdout and stderr going to files there (no
-// pipe to fill up), stdin closed; returns its process id for finish_process.
-inline pid_t start_process(const std::vector<std::string>& argv, const fs::path& cwd) {
->>>>>>> 36bc613 (Scale-out tests share tests/run_drt.h (process start/finish, mpirun); resumed-render and MPI stop tests made independent of timing; usage doc: checkpoints, interrupts, MPI with a hostfile example)
+// pipe to fill up), stdin closed; returns its process id for finish_process. `address_space`,
+// when not 0, caps the child's memory (RLIMIT_AS), so that an allocation fails.
+inline pid_t start_process(const std::vector<std::string>& argv, const fs::path& cwd,
+                           rlim_t address_space = 0) {
     const fs::path out_file = cwd / ".drt_stdout", err_file = cwd / ".drt_stderr";
     const pid_t pid = fork();
     if (pid == 0) {
@@ -66,15 +60,9 @@ inline Outcome finish_process(pid_t pid, const fs::path& cwd) {
     int wstatus = 0;
     waitpid(pid, &wstatus, 0);
     Outcome r;
-<<<<<<< HEAD
     // -1 for a crash or an abort: no test expects one.
     r.status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus) : -1;
-=======
-    r.status = WIFEXITED(wstatus)     ? WEXITSTATUS(wstatus)
-               : WIFSIGNALED(wstatus) ? 128 + WTERMSIG(wstatus)
-                                      : -1;
     const fs::path out_file = cwd / ".drt_stdout", err_file = cwd / ".drt_stderr";
->>>>>>> 36bc613 (Scale-out tests share tests/run_drt.h (process start/finish, mpirun); resumed-render and MPI stop tests made independent of timing; usage doc: checkpoints, interrupts, MPI with a hostfile example)
     r.out = read_bytes(out_file);
     r.err = read_bytes(err_file);
     fs::remove(out_file);
@@ -86,11 +74,12 @@ inline Outcome run_process(const std::vector<std::string>& argv, const fs::path&
     return finish_process(start_process(argv, cwd), cwd);
 }
 
-// Runs the drt binary with `args` in `cwd`.
-inline Outcome run_drt(const std::vector<std::string>& args, const fs::path& cwd) {
+// Runs the drt binary with `args` in `cwd` (memory capped as start_process says).
+inline Outcome run_drt(const std::vector<std::string>& args, const fs::path& cwd,
+                       rlim_t address_space = 0) {
     std::vector<std::string> argv{DRT_BINARY};
     argv.insert(argv.end(), args.begin(), args.end());
-    return run_process(argv, cwd);
+    return finish_process(start_process(argv, cwd, address_space), cwd);
 }
 
 }  // namespace drt::test
