@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "drt/mesh.h"
 #include "drt/plane.h"
 #include "drt/sphere.h"
 
@@ -95,6 +96,29 @@ Bvh::Bvh(const std::vector<std::unique_ptr<Object>>& objects) {
             const PlaneShape& plane = shapes.planes[i];
             planes_.push_back({plane.point, plane.normal, max_abs_component(plane.point),
                                dot(plane.point, plane.normal), object, i});
+        }
+        for (const MeshShape& shape : shapes.meshes) {
+            if (shape.mesh->triangle_count() == 0) continue;
+            const Bounds local = shape.mesh->bounds();
+            const auto index = static_cast<std::uint32_t>(meshes_.size());
+            meshes_.push_back({shape.mesh, local.centre()});
+            const double radius = length(local.extent()) * 0.5;
+            const MotionPath& path = *shape.path;
+            if (!path.moves()) {
+                const Vec3 o = path.at(0);
+                add({o, radius, {-kInfinity, kInfinity}, object, index, Kind::kStillMesh, 0},
+                    Bounds{o + local.lo, o + local.hi});
+                continue;
+            }
+            for (std::size_t k = 0; k < path.segment_count(); ++k) {
+                const PathSegment segment = path.segment(k);
+                const auto motion = static_cast<std::uint32_t>(motions_.size());
+                motions_.push_back(segment);
+                add({segment.from, radius, path.segment_time(k), object, index, Kind::kMovingMesh,
+                     motion},
+                    Bounds{segment.from + local.lo, segment.from + local.hi}.grow(
+                        Bounds{segment.to + local.lo, segment.to + local.hi}));
+            }
         }
         for (std::uint32_t i = 0; i < shapes.spheres.size(); ++i) {
             const MotionPath& path = *shapes.spheres[i].path;
@@ -208,19 +232,28 @@ std::uint32_t Bvh::build(std::vector<Build>& items, std::uint32_t begin, std::ui
     return index;
 }
 
-// Still spheres, the common case, inline; a moving sphere's segment out of line.
+// Still spheres, the common case, inline; a moving sphere's segment and meshes out of line.
 inline std::optional<double> Bvh::hit(const Primitive& p, const Ray& ray, double origin_scale,
-                                      Interval range, Vec2& /*uv*/) const {
+                                      Interval range, std::uint32_t& triangle, Vec2& uv) const {
     if (p.kind == Kind::kStillSphere) {
         return intersect_sphere(p.centre, p.radius, ray, origin_scale, range);
     }
-    return hit_segment(p, ray, origin_scale, range);
+    return hit_segment(p, ray, origin_scale, range, triangle, uv);
 }
 
 std::optional<double> Bvh::hit_segment(const Primitive& p, const Ray& ray, double origin_scale,
-                                       Interval range) const {
+                                       Interval range, std::uint32_t& triangle, Vec2& uv) const {
     if (!p.time.contains(ray.time)) return std::nullopt;
-    return intersect_sphere(motions_[p.motion].at(ray.time), p.radius, ray, origin_scale, range);
+    if (p.kind == Kind::kMovingSphere) {
+        return intersect_sphere(motions_[p.motion].at(ray.time), p.radius, ray, origin_scale,
+                                range);
+    }
+    const Vec3 origin = p.kind == Kind::kStillMesh ? p.centre : motions_[p.motion].at(ray.time);
+    const auto hit = meshes_[p.index].mesh->intersect(ray_in_mesh(ray, origin), range);
+    if (!hit) return std::nullopt;
+    triangle = hit->triangle;
+    uv = {hit->b.b1, hit->b.b2};
+    return hit->t;
 }
 
 template <bool kAnyHit>
@@ -239,13 +272,15 @@ bool Bvh::traverse(const Ray& ray, Interval& range, std::uint64_t planes, Neares
     }
     if (nodes_.empty()) return found;
     // Tests a leaf's primitives; true when an any-hit query is answered.
-    Vec2 uv;  // written only by primitives whose test yields coordinates
+    // Written only by primitives whose test yields them: a mesh's triangle and coordinates.
+    std::uint32_t triangle = 0;
+    Vec2 uv;
     auto leaf = [&](const Node& node) {
         for (std::uint32_t i = node.offset; i < node.offset + node.count; ++i) {
             const Primitive& p = primitives_[i];
-            if (auto t = hit(p, ray, origin_scale, range, uv)) {
+            if (auto t = hit(p, ray, origin_scale, range, triangle, uv)) {
                 if constexpr (kAnyHit) return true;
-                found = true, nearest = {p.object, p.index, uv};
+                found = true, nearest = {p.object, is_mesh(p.kind) ? triangle : p.index, uv};
                 range.max = *t;
             }
         }
@@ -321,9 +356,10 @@ bool Bvh::occluded_by(const Ray& ray, Interval range, std::uint64_t planes,
         if (intersect_plane(p.point, p.normal, p.point_scale, ray, origin_scale, range))
             return true;
     }
+    std::uint32_t triangle = 0;
     Vec2 uv;
     for (const std::uint32_t i : primitives) {
-        if (hit(primitives_[i], ray, origin_scale, range, uv)) return true;
+        if (hit(primitives_[i], ray, origin_scale, range, triangle, uv)) return true;
     }
     return false;
 }

@@ -407,4 +407,39 @@ bool TriangleMesh::occluded(const Ray& ray, Interval range) const {
     return traverse<true>(ray, range).has_value();
 }
 
+namespace {
+
+std::vector<Vec3> shifted(std::vector<Vec3> points, const Vec3& by) {
+    for (Vec3& p : points) p += by;
+    return points;
+}
+
+}  // namespace
+
+Mesh::Mesh(std::shared_ptr<const TriangleMesh> mesh, const std::vector<Vec3>& translations,
+           const Material& material, SurfaceDetail detail)
+    : Object(material, std::move(detail)),
+      mesh_(std::move(mesh)),
+      path_(shifted(translations, mesh_->origin())) {}
+
+std::optional<Hit> Mesh::intersect(const Ray& ray, Interval range) const {
+    const auto hit = mesh_->intersect(ray_in_mesh(ray, path_.at(ray.time)), range);
+    if (!hit) return std::nullopt;
+    return Hit{hit->t, this, hit->triangle, {hit->b.b1, hit->b.b2}};
+}
+
+Object::SurfacePoint Mesh::locate(const Ray& ray, const Hit& hit) const {
+    const Vec3 origin = path_.at(ray.time);
+    const auto [a, b, c] = mesh_->corners(hit.primitive);
+    const Barycentrics w{1 - hit.uv.x - hit.uv.y, hit.uv.x, hit.uv.y};
+    // From the barycentrics rather than ray.at(t): on the triangle's plane to rounding in the
+    // mesh's own coordinates, whatever distance the ray came from.
+    const Vec3 point = origin + (a * w.b0 + b * w.b1 + c * w.b2);
+    const Vec3 normal = mesh_->geometric_normal(hit.primitive);
+    // Textures and bumps stay where the mesh is at time 0, the present: world coordinates for
+    // a mesh that does not move.
+    const Vec3 fixed = point - (origin - path_.at(0));
+    return {point, normal, mesh_->shading_normal(hit.primitive, w), fixed, fixed};
+}
+
 }  // namespace drt

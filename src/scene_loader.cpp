@@ -26,6 +26,8 @@
 #include <vector>
 
 #include "drt/limits.h"
+#include "drt/mesh.h"
+#include "drt/obj_reader.h"
 #include "drt/plane.h"
 #include "drt/sampler.h"
 #include "drt/sphere.h"
@@ -84,9 +86,9 @@ std::optional<std::string_view> nearest(std::string_view name,
 // Every element the format knows, wherever it may stand; an element from this list in the wrong
 // place is reported as misplaced rather than unknown.
 constexpr std::string_view kElementNames[] = {
-    "Scene",     "Image",  "Render",  "Background", "Ambient", "Camera", "DepthOfField",
-    "Materials", "Lights", "Objects", "Light",      "Plane",   "Sphere", "MotionBlurPosition",
-    "Material",
+    "Scene",     "Image",    "Render",  "Background", "Ambient", "Camera", "DepthOfField",
+    "Materials", "Lights",   "Objects", "Light",      "Plane",   "Sphere", "MotionBlurPosition",
+    "Material",  "Triangle", "Mesh",
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -465,6 +467,8 @@ class SceneReader {
             {"Light", &SceneReader::read_light},
             {"Plane", &SceneReader::read_plane},
             {"Sphere", &SceneReader::read_sphere},
+            {"Triangle", &SceneReader::read_triangle},
+            {"Mesh", &SceneReader::read_mesh},
         };
         Attributes in(e, context_);
         in.warn_unknown();
@@ -474,9 +478,9 @@ class SceneReader {
     // <Lights> and <Objects> only group; either may hold any light or object.
     void read_group(const XMLElement& e) {
         static constexpr Child kChildren[] = {
-            {"Light", &SceneReader::read_light},
-            {"Plane", &SceneReader::read_plane},
-            {"Sphere", &SceneReader::read_sphere},
+            {"Light", &SceneReader::read_light},   {"Plane", &SceneReader::read_plane},
+            {"Sphere", &SceneReader::read_sphere}, {"Triangle", &SceneReader::read_triangle},
+            {"Mesh", &SceneReader::read_mesh},
         };
         Attributes in(e, context_);
         in.warn_unknown();
@@ -684,6 +688,86 @@ class SceneReader {
                             [path = std::move(path), radius](const Material& m, SurfaceDetail d) {
                                 return std::make_unique<Sphere>(path, radius, m, std::move(d));
                             }});
+    }
+
+    // Triangles and meshes (../shared/spec/scene-format.md, "Triangles and meshes").
+
+    void read_triangle(const XMLElement& e) {
+        Attributes in(e, context_);
+        ObjMesh obj;
+        obj.positions = {in.vec3("Ax", "Ay", "Az"), in.vec3("Bx", "By", "Bz"),
+                         in.vec3("Cx", "Cy", "Cz")};
+        obj.position_indices = {0, 1, 2};
+        obj.normal_indices.assign(3, ObjMesh::kNoNormal);
+        std::string material = in.text("Material");
+        SurfaceSpec surface = read_surface(in);
+        in.warn_unknown();
+        warn_children(e);
+        auto mesh = build_mesh(in, obj, {}, false);
+        if (mesh->dropped() > 0) context_.warn(e, "<Triangle> of zero area dropped");
+        pending_.push_back({&e, std::move(material), std::move(surface),
+                            [mesh = std::move(mesh)](const Material& m, SurfaceDetail d) {
+                                return std::make_unique<Mesh>(mesh, std::vector<Vec3>{Vec3{}}, m,
+                                                              std::move(d));
+                            }});
+    }
+
+    void read_mesh(const XMLElement& e) {
+        Attributes in(e, context_);
+        const std::string file = in.text("File");
+        std::string material = in.text("Material");
+        std::vector<Vec3> path{in.vec3("Tx", "Ty", "Tz", {})};
+        MeshTransform transform;
+        transform.scale = in.number("Scale", 1);
+        in.check(transform.scale > 0, "Scale", "positive");
+        transform.rotate_degrees = in.vec3("RotateX", "RotateY", "RotateZ", {});
+        const bool smooth = in.flag("Smooth", true);
+        SurfaceSpec surface = read_surface(in);
+        in.warn_unknown();
+        warn_stray_text(e);
+        static constexpr std::string_view kChildren[] = {"MotionBlurPosition"};
+        for (const XMLElement* c = e.FirstChildElement(); c; c = c->NextSiblingElement()) {
+            if (std::string_view(c->Name()) != kChildren[0]) {
+                context_.warn_unknown_element(*c, e, kChildren);
+                continue;
+            }
+            Attributes at(*c, context_);
+            path.push_back(at.vec3("Tx", "Ty", "Tz"));
+            at.warn_unknown();
+            warn_children(*c);
+        }
+
+        // Relative to the scene file's folder, as the scene's author sees it.
+        const std::filesystem::path obj_path =
+            std::filesystem::path(context_.file()).parent_path() / file;
+        ObjMesh obj;
+        try {
+            obj = read_obj(obj_path);
+        } catch (const ObjOpenError& error) {
+            in.fail("cannot open " + obj_path.string() + ": " + error.what());
+        } catch (const ObjError& error) {
+            throw SceneError(error.what());
+        }
+        auto mesh = build_mesh(in, obj, transform, smooth);
+        if (const std::size_t n = mesh->dropped(); n > 0) {
+            context_.warn(e, std::to_string(n) + (n == 1 ? " triangle" : " triangles") +
+                                 " of zero area in " + obj_path.string() + " dropped");
+        }
+        pending_.push_back(
+            {&e, std::move(material), std::move(surface),
+             [mesh = std::move(mesh), path = std::move(path)](const Material& m, SurfaceDetail d) {
+                 return std::make_unique<Mesh>(mesh, path, m, std::move(d));
+             }});
+    }
+
+    static std::shared_ptr<const TriangleMesh> build_mesh(const Attributes& in, const ObjMesh& obj,
+                                                          const MeshTransform& transform,
+                                                          bool smooth) {
+        try {
+            return std::make_shared<const TriangleMesh>(obj, transform, smooth);
+        } catch (const std::domain_error& error) {
+            in.fail(error.what());
+        }
     }
 
     void resolve_objects() {

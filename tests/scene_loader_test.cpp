@@ -9,6 +9,7 @@
 
 #include <unistd.h>
 
+#include "drt/mesh.h"
 #include "drt/plane.h"
 #include "drt/sphere.h"
 
@@ -932,6 +933,134 @@ TEST(SceneLoaderErrors, LongValuesAreCutInMessages) {
     EXPECT_EQ(body_error("<Sphere Px=\"1" + std::string(400, '0') + "\"/>"),
               "t.xml:2: Sphere: attribute 'Px' is out of range: \"10000000000000000000... (401 "
               "characters)\"");
+}
+
+}  // namespace
+}  // namespace drt
+
+namespace drt {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Triangles and meshes
+
+const Mesh& mesh(const Scene& scene, std::size_t i) {
+    return dynamic_cast<const Mesh&>(*scene.objects.at(i));
+}
+
+TEST(SceneLoader, ReadsATriangle) {
+    const LoadedScene loaded =
+        load(in_scene(std::string(kGray) + "<Triangle Ax=\"1\" Ay=\"0\" Az=\"0\" Bx=\"3\" "
+                                           "By=\"0\" Bz=\"0\" Cx=\"1\" Cy=\"2\" Cz=\"0\" "
+                                           "Material=\"Gray\" EnableTexture=\"1\"/>"));
+    const Mesh& m = mesh(loaded.scene, 0);
+    ASSERT_EQ(m.mesh().triangle_count(), 1u);
+    const auto [a, b, c] = m.mesh().corners(0);
+    const Vec3 o = m.path().at(0);
+    expect_vec(a + o, 1, 0, 0);
+    expect_vec(b + o, 3, 0, 0);
+    expect_vec(c + o, 1, 2, 0);
+    expect_vec(m.mesh().geometric_normal(0), 0, 0, 1);
+    EXPECT_TRUE(m.detail().texture);
+    EXPECT_FALSE(m.moves());
+}
+
+TEST(SceneLoader, TriangleNeedsNineCoordinatesAndAMaterial) {
+    EXPECT_EQ(body_error(std::string(kGray) + "\n<Triangle Ax=\"0\" Ay=\"0\" Az=\"0\" Bx=\"1\" "
+                                              "By=\"0\" Bz=\"0\" Cx=\"0\" Cy=\"1\" "
+                                              "Material=\"Gray\"/>"),
+              "t.xml:3: Triangle: missing required attribute 'Cz'");
+    EXPECT_EQ(body_error(std::string(kGray) + "\n<Triangle Ax=\"0\" Ay=\"0\" Az=\"0\" Bx=\"1\" "
+                                              "By=\"0\" Bz=\"0\" Cx=\"0\" Cy=\"1\" Cz=\"0\"/>"),
+              "t.xml:3: Triangle: missing required attribute 'Material'");
+    EXPECT_EQ(body_error(std::string(kGray) + "\n<Triangle Ax=\"0\" Ay=\"0\" Az=\"nan\" Bx=\"1\" "
+                                              "By=\"0\" Bz=\"0\" Cx=\"0\" Cy=\"1\" Cz=\"0\" "
+                                              "Material=\"Gray\"/>"),
+              "t.xml:3: Triangle: attribute 'Az' is not a number: \"nan\"");
+}
+
+TEST(SceneLoader, ATriangleOfZeroAreaIsDroppedWithAWarning) {
+    const LoadedScene loaded =
+        load(in_scene(std::string(kGray) + "\n<Triangle Ax=\"0\" Ay=\"0\" Az=\"0\" Bx=\"1\" "
+                                           "By=\"1\" Bz=\"1\" Cx=\"2\" Cy=\"2\" Cz=\"2\" "
+                                           "Material=\"Gray\"/>"));
+    EXPECT_EQ(mesh(loaded.scene, 0).mesh().triangle_count(), 0u);
+    EXPECT_EQ(loaded.warnings,
+              std::vector<std::string>{"t.xml:3: warning: <Triangle> of zero area dropped"});
+}
+
+constexpr std::string_view kTetrahedron =
+    "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+    "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+
+TEST_F(SceneFile, ReadsAMeshRelativeToTheScenesFolder) {
+    std::filesystem::create_directories(dir_ / "models");
+    write("models/tet.obj", kTetrahedron);
+    const std::string scene =
+        write("s.xml",
+              "<Scene><Materials><Gray/></Materials>\n"
+              "<Mesh File=\"models/tet.obj\" Material=\"Gray\" Scale=\"2\" RotateZ=\"90\" "
+              "Tx=\"10\" Ty=\"20\" Tz=\"30\" Smooth=\"0\" bumpEnable=\"1\">\n"
+              "<MotionBlurPosition Tx=\"11\" Ty=\"20\" Tz=\"30\"/>\n"
+              "</Mesh></Scene>\n");
+    const LoadedScene loaded = load_scene(scene);
+    EXPECT_TRUE(loaded.warnings.empty());
+    const Mesh& m = mesh(loaded.scene, 0);
+    ASSERT_EQ(m.mesh().triangle_count(), 4u);
+    EXPECT_FALSE(m.mesh().smooth());
+    EXPECT_TRUE(m.detail().bump);
+    EXPECT_DOUBLE_EQ(m.motion_end(), 1);
+    // Vertex (1, 0, 0) scaled to (2, 0, 0), turned a quarter about z to (0, 2, 0), moved by T.
+    Bounds world;
+    for (std::uint32_t t = 0; t < 4; ++t) {
+        for (const Vec3& p : m.mesh().corners(t)) world.grow(p + m.path().at(0));
+    }
+    // (0, 1, 0) to (0, 2, 0) to (-2, 0, 0).
+    expect_vec(world.lo, 8, 20, 30);
+    expect_vec(world.hi, 10, 22, 32);
+    expect_vec(m.path().at(1) - m.path().at(0), 1, 0, 0);
+}
+
+TEST_F(SceneFile, MeshErrors) {
+    write("tet.obj", kTetrahedron);
+    write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+    const auto error_of_mesh = [&](std::string_view attributes) {
+        return error_loading(write("s.xml", "<Scene><Materials><Gray/></Materials>\n<Mesh " +
+                                                std::string(attributes) + "/></Scene>\n"));
+    };
+    const std::string s = (dir_ / "s.xml").string();
+    EXPECT_EQ(error_of_mesh("File=\"nope.obj\" Material=\"Gray\""),
+              s + ":2: Mesh: cannot open " + (dir_ / "nope.obj").string() +
+                  ": No such file or directory");
+    EXPECT_EQ(
+        error_of_mesh("File=\"bad.obj\" Material=\"Gray\""),
+        (dir_ / "bad.obj").string() + ":4: f: vertex index 4 is out of range; 3 defined above");
+    EXPECT_EQ(error_of_mesh("Material=\"Gray\""),
+              s + ":2: Mesh: missing required attribute 'File'");
+    EXPECT_EQ(error_of_mesh("File=\"tet.obj\""),
+              s + ":2: Mesh: missing required attribute 'Material'");
+    EXPECT_EQ(error_of_mesh("File=\"tet.obj\" Material=\"Gray\" Scale=\"0\""),
+              s + ":2: Mesh: Scale must be positive, got 0");
+    EXPECT_EQ(error_of_mesh("File=\"tet.obj\" Material=\"Gray\" Scale=\"-2\""),
+              s + ":2: Mesh: Scale must be positive, got -2");
+    EXPECT_EQ(error_of_mesh("File=\"tet.obj\" Material=\"Gray\" Smooth=\"2\""),
+              s + ":2: Mesh: Smooth must be 0 or 1, got \"2\"");
+    EXPECT_EQ(error_of_mesh("File=\"tet.obj\" Material=\"Gray\" Scale=\"1e300\""),
+              s + ":2: Mesh: vertex 1 is beyond single precision (±3.4e38) once transformed");
+    EXPECT_EQ(error_of_mesh("File=\"tet.obj\" Material=\"Grey\""),
+              s + ":2: Mesh: unknown material 'Grey'; did you mean 'Gray'?");
+}
+
+TEST_F(SceneFile, ZeroAreaTrianglesOfAMeshAreCountedInOneWarning) {
+    write("m.obj", std::string(kTetrahedron) + "f 1 1 2\nf 2 3 2\nf 1 2 2\n");
+    const std::string s = write("s.xml",
+                                "<Scene><Materials><Gray/></Materials>\n"
+                                "<Mesh File=\"m.obj\" Material=\"Gray\"/></Scene>\n");
+    const LoadedScene loaded = load_scene(s);
+    EXPECT_EQ(mesh(loaded.scene, 0).mesh().triangle_count(), 4u);
+    EXPECT_EQ(loaded.warnings,
+              std::vector<std::string>{s + ":2: warning: 3 triangles of zero area in " +
+                                       (dir_ / "m.obj").string() + " dropped"});
 }
 
 }  // namespace

@@ -51,17 +51,26 @@ class Bvh {
     bool visit_near(double time, const MayMeet& may_meet, const Visit& visit) const;
 
   private:
-    enum class Kind : std::uint32_t { kStillSphere, kMovingSphere };
+    enum class Kind : std::uint32_t { kStillSphere, kMovingSphere, kStillMesh, kMovingMesh };
 
-    // One still sphere or one segment of a moving sphere's path, in leaf order.
+    // One still sphere or mesh, or one segment of a moving one's path, in leaf order.
     struct alignas(64) Primitive {
-        Vec3 centre;  // a still sphere's (a moving one's is motions_[motion].at(time))
-        double radius;
+        // A still sphere's centre, or a still mesh's own origin (a moving one's is
+        // motions_[motion].at(time))
+        Vec3 centre;
+        double radius;         // a mesh's: of a ball about meshes_[index].ball_offset from centre
         Interval time;         // shutter times at which this piece is where the bounds say
         std::uint32_t object;  // index into objects_
-        std::uint32_t index;   // Hit::primitive: which of the object's shapes
+        std::uint32_t index;   // a sphere's Hit::primitive; a mesh's index into meshes_
         Kind kind;
-        std::uint32_t motion;  // index into motions_ for a moving sphere
+        std::uint32_t motion;  // index into motions_ for a moving sphere or mesh
+    };
+    static constexpr bool is_mesh(Kind kind) {
+        return kind == Kind::kStillMesh || kind == Kind::kMovingMesh;
+    }
+    struct MeshData {
+        const TriangleMesh* mesh;
+        Vec3 ball_offset;  // centre of the mesh's bounds in its own coordinates
     };
     // A node is one cache line: its box, the time span of what it holds (rounded outwards to
     // float), and its primitives (leaf) or its second child (inner; the first follows it).
@@ -93,20 +102,24 @@ class Bvh {
     template <bool kAnyHit>
     bool traverse(const Ray& ray, Interval& range, std::uint64_t planes, Nearest& nearest) const;
     // The one leaf test: the ray parameter inside `range` at which the ray meets primitive p at
-    // the ray's time. `uv` receives the primitive's own coordinates where its test yields them.
+    // the ray's time. A mesh writes the triangle it hit and its barycentrics b1, b2 into
+    // `triangle` and `uv`.
     std::optional<double> hit(const Primitive& p, const Ray& ray, double origin_scale,
-                              Interval range, Vec2& uv) const;
+                              Interval range, std::uint32_t& triangle, Vec2& uv) const;
     std::optional<double> hit_segment(const Primitive& p, const Ray& ray, double origin_scale,
-                                      Interval range) const;
+                                      Interval range, std::uint32_t& triangle, Vec2& uv) const;
     // Where primitive p is at `time`, as a ball (for the shadow-ray culling).
     Ball ball_at(const Primitive& p, double time) const {
         if (p.kind == Kind::kStillSphere) return {p.centre, p.radius};
-        return {motions_[p.motion].at(time), p.radius};
+        const Vec3 at = p.kind == Kind::kStillMesh ? p.centre : motions_[p.motion].at(time);
+        if (p.kind == Kind::kMovingSphere) return {at, p.radius};
+        return {at + meshes_[p.index].ball_offset, p.radius};
     }
 
     std::vector<const Object*> objects_;
     std::vector<Primitive> primitives_;  // in leaf order
     std::vector<PathSegment> motions_;
+    std::vector<MeshData> meshes_;
     std::vector<Node> nodes_;
     std::vector<PlaneData> planes_;
 };

@@ -7,11 +7,14 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include "drt/math.h"
+#include "drt/motion.h"
 #include "drt/obj_reader.h"
+#include "drt/object.h"
 #include "drt/ray.h"
 #include "drt/triangle.h"
 
@@ -91,5 +94,35 @@ class TriangleMesh {
     std::vector<Node> nodes_;
     std::size_t dropped_ = 0;
 };
+
+// A mesh in the scene: a TriangleMesh translated by T, and moving like a sphere when given more
+// translations (T at time 0, the present, then one per time unit into the past). Both sides of
+// every triangle are seen; the winding tells outside from inside.
+class Mesh final : public Object {
+  public:
+    Mesh(std::shared_ptr<const TriangleMesh> mesh, const std::vector<Vec3>& translations,
+         const Material& material, SurfaceDetail detail = {});
+
+    std::optional<Hit> intersect(const Ray& ray, Interval range) const override;
+    Shapes shapes() const override { return {{}, {}, {MeshShape{mesh_.get(), &path_}}}; }
+    double motion_end() const override { return path_.end(); }
+
+    const TriangleMesh& mesh() const { return *mesh_; }
+    // Where the mesh's own origin is at each time.
+    const MotionPath& path() const { return path_; }
+
+  protected:
+    SurfacePoint locate(const Ray& ray, const Hit& hit) const override;
+
+  private:
+    std::shared_ptr<const TriangleMesh> mesh_;
+    MotionPath path_;
+};
+
+// The ray moved into a mesh's own coordinates, whose origin is at `origin`: the BVH and
+// Mesh::intersect both use it, so that they find the same hit.
+inline Ray ray_in_mesh(const Ray& ray, const Vec3& origin) {
+    return {ray.origin - origin, ray.dir, ray.time};
+}
 
 }  // namespace drt

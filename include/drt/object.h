@@ -50,6 +50,13 @@ struct SphereShape {
 struct PlaneShape {
     Vec3 point, normal;  // normal of unit length
 };
+class TriangleMesh;
+// A triangle mesh enters the BVH whole (one piece per segment of its path), and the BVH's leaf
+// test runs the mesh's own hierarchy on the ray moved into the mesh's coordinates.
+struct MeshShape {
+    const TriangleMesh* mesh;  // owned by the object, which outlives the BVH
+    const MotionPath* path;    // where the mesh's own origin is at each time
+};
 // An object's geometry in the typed forms the BVH tests inline (no virtual call and no pointer
 // chase per ray). A new kind of primitive gets its array here, its Kind and case in the BVH's
 // one leaf test (Bvh::hit) and its bounds in the BVH's build; Hit::primitive is its index in
@@ -57,6 +64,7 @@ struct PlaneShape {
 struct Shapes {
     std::vector<SphereShape> spheres;
     std::vector<PlaneShape> planes;  // unbounded: tested outside the tree
+    std::vector<MeshShape> meshes = {};
 };
 
 // How an object's surface departs from its material's plain colour.
