@@ -14,16 +14,6 @@ namespace {
 
 using testing::near;
 
-ObjMesh obj_of(const testing::TestMesh& m) {
-    ObjMesh obj;
-    obj.positions = m.vertices;
-    for (const auto& t : m.triangles) {
-        obj.position_indices.insert(obj.position_indices.end(), t.begin(), t.end());
-        obj.normal_indices.insert(obj.normal_indices.end(), 3, ObjMesh::kNoNormal);
-    }
-    return obj;
-}
-
 TEST(MeshTransform, ScalesThenRotatesAboutXThenYThenZ) {
     EXPECT_EQ((MeshTransform{2, {90, 0, 0}}.apply({0, 1, 0})), (Vec3{0, 0, 2}));
     EXPECT_EQ((MeshTransform{1, {0, 90, 0}}.apply({0, 0, 1})), (Vec3{1, 0, 0}));
@@ -69,8 +59,8 @@ TEST(TriangleMesh, RejectsCoordinatesBeyondSinglePrecision) {
 }
 
 TEST(TriangleMesh, SmoothNormalsOfASphereArePointsOnItAndFlatOnesAreTheFaces) {
-    const TriangleMesh smooth(obj_of(testing::icosphere(1)), {}, true);
-    const TriangleMesh flat(obj_of(testing::icosphere(1)), {}, false);
+    const TriangleMesh smooth(testing::obj_of(testing::icosphere(1)), {}, true);
+    const TriangleMesh flat(testing::obj_of(testing::icosphere(1)), {}, false);
     EXPECT_TRUE(smooth.smooth());
     EXPECT_FALSE(flat.smooth());
     for (std::uint32_t t = 0; t < smooth.triangle_count(); ++t) {
@@ -109,7 +99,7 @@ TEST(TriangleMesh, NearestHitIsThatOfTestingEveryTriangle) {
             soup.vertices.push_back(centre + testing::unit_vector(13, 3 * i + k) * 0.05);
         soup.triangles.push_back({first, first + 1, first + 2});
     }
-    const TriangleMesh mesh(obj_of(soup), {}, false);
+    const TriangleMesh mesh(testing::obj_of(soup), {}, false);
     ASSERT_EQ(mesh.triangle_count(), soup.triangles.size());
     for (std::uint64_t r = 0; r < 2000; ++r) {
         const Vec3 origin = testing::unit_vector(14, r) * (r % 2 ? 0.5 : 3.0);
@@ -133,7 +123,7 @@ TEST(TriangleMesh, NearestHitIsThatOfTestingEveryTriangle) {
 }
 
 TEST(TriangleMesh, TakesUnderEightyBytesPerTriangleWithItsHierarchy) {
-    const TriangleMesh smooth(obj_of(testing::icosphere(5)), {}, true);
+    const TriangleMesh smooth(testing::obj_of(testing::icosphere(5)), {}, true);
     ASSERT_EQ(smooth.triangle_count(), 20480u);
     const double per_triangle = static_cast<double>(smooth.bytes()) / smooth.triangle_count();
     EXPECT_LT(per_triangle, 80);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "drt/math.h"
+#include "drt/obj_reader.h"
 
 namespace drt::testing {
 
@@ -63,6 +64,17 @@ inline TestMesh icosphere(int levels, double radius = 1, Vec3 centre = {}) {
     for (const Vec3& p : v) m.vertices.push_back(to_float(centre + p * radius));
     m.triangles = std::move(t);
     return m;
+}
+
+// The mesh as the OBJ reader would give it, without normals.
+inline ObjMesh obj_of(const TestMesh& m) {
+    ObjMesh obj;
+    obj.positions = m.vertices;
+    for (const auto& t : m.triangles) {
+        obj.position_indices.insert(obj.position_indices.end(), t.begin(), t.end());
+        obj.normal_indices.insert(obj.normal_indices.end(), 3, ObjMesh::kNoNormal);
+    }
+    return obj;
 }
 
 }  // namespace drt::testing
