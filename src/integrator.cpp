@@ -105,7 +105,8 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
 
     Color result;
     if (m.has_diffuse()) {
-        const Color light = scene_.ambient + direct_light(surface.point, geometric, shading,
+        const Vec3 above = outside ? surface.light_normal : -surface.light_normal;
+        const Color light = scene_.ambient + direct_light(surface.light_point, above, shading,
                                                           ray.time, s, depth, work.counts);
         result += m.diffuse * surface.kd * light;
     }

@@ -216,6 +216,22 @@ Vec3 TriangleMesh::shading_normal(std::uint32_t triangle, const Barycentrics& b)
     return normalize(n);
 }
 
+Vec3 TriangleMesh::lifted(std::uint32_t triangle, const Barycentrics& b) const {
+    const auto& t = triangles_[triangle];
+    const auto [p0, p1, p2] = corners(triangle);
+    const Vec3 p = p0 * b.b0 + p1 * b.b1 + p2 * b.b2;
+    // Each corner's tangent plane lifts the point onto it where the point is below it; the
+    // lifts are blended by the barycentrics, which gives a smooth surface through the corners.
+    Vec3 lift;
+    const double weights[3] = {b.b0, b.b1, b.b2};
+    const Vec3 vertices[3] = {p0, p1, p2};
+    for (int k = 0; k < 3; ++k) {
+        const Vec3 n = to_vec3(normals_[t[k]]);
+        lift -= n * (weights[k] * std::min(0.0, dot(p - vertices[k], n)));
+    }
+    return p + lift;
+}
+
 Bounds TriangleMesh::bounds() const {
     if (nodes_.empty()) return {};
     return {to_vec3(nodes_[0].lo), to_vec3(nodes_[0].hi)};
@@ -439,7 +455,10 @@ Object::SurfacePoint Mesh::locate(const Ray& ray, const Hit& hit) const {
     // Textures and bumps stay where the mesh is at time 0, the present: world coordinates for
     // a mesh that does not move.
     const Vec3 fixed = point - (origin - path_.at(0));
-    return {point, normal, mesh_->shading_normal(hit.primitive, w), fixed, fixed};
+    const Vec3 shading = mesh_->shading_normal(hit.primitive, w);
+    if (!mesh_->smooth()) return {point, normal, shading, fixed, fixed};
+    return {point, normal, shading,
+            fixed, fixed,  LightStart{origin + mesh_->lifted(hit.primitive, w), shading}};
 }
 
 }  // namespace drt

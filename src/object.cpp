@@ -10,6 +10,9 @@ SurfaceHit Object::surface_at(const Ray& ray, const Hit& hit) const {
     surface.shading_normal =
         detail_.bump ? detail_.bump->perturb(at.shading_normal, at.bump_point) : at.shading_normal;
     surface.kd = detail_.texture ? detail_.texture->value(at.texture_point) : material_->kd;
+    const LightStart light = at.light_start.value_or(LightStart{at.point, at.normal});
+    surface.light_point = light.point;
+    surface.light_normal = light.normal;
     return surface;
 }
 

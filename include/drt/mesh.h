@@ -65,6 +65,9 @@ class TriangleMesh {
     // way relative to the geometric normal.
     Vec3 shading_normal(std::uint32_t triangle, const Barycentrics& b) const;
     bool smooth() const { return !normals_.empty(); }
+    // For a smooth mesh, the point at `b` moved out onto the curved surface that the vertex
+    // normals describe (LightStart in object.h).
+    Vec3 lifted(std::uint32_t triangle, const Barycentrics& b) const;
 
     // Memory held for geometry and hierarchy.
     std::size_t bytes() const;

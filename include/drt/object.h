@@ -39,6 +39,18 @@ struct SurfaceHit {
     Vec3 normal;          // geometric, unit, pointing out of the object
     Vec3 shading_normal;  // normal after bump mapping, same side as `normal`
     Color kd;             // diffuse colour after texturing
+    // Where shadow rays leave, and the normal that says which lights are above the surface:
+    // `point` and `normal`, except on a smooth mesh (LightStart).
+    Vec3 light_point, light_normal;
+};
+
+// On a mesh with interpolated normals, the lights a shading normal sees may be below the flat
+// facet, and shadow rays from the facet would meet the facet's neighbours: black facets along
+// the shadow terminator. Shadow rays leave instead from the point lifted onto the curved surface
+// the vertex normals describe (Hanika, "Hacking the shadow terminator", Ray Tracing Gems II,
+// 2021), and the interpolated normal decides which lights are above.
+struct LightStart {
+    Vec3 point, normal;
 };
 
 // A sphere as the BVH stores it: the BVH splits its path into one piece per segment, each bounded
@@ -107,6 +119,7 @@ class Object {
         // Coordinates a texture is evaluated in (fixed to a moving object), and world-aligned
         // ones for bump noise.
         Vec3 texture_point, bump_point;
+        std::optional<LightStart> light_start = {};  // absent: from point, by normal
     };
     virtual SurfacePoint locate(const Ray& ray, const Hit& hit) const = 0;
 
