@@ -662,6 +662,23 @@ class SceneReader {
                             }});
     }
 
+    // The <MotionBlurPosition> children of a sphere (Px Py Pz) or mesh (Tx Ty Tz), appended to
+    // its path; anything else inside is warned about.
+    void read_motion(const XMLElement& e, std::string_view x, std::string_view y,
+                     std::string_view z, std::vector<Vec3>& path) {
+        static constexpr std::string_view kChildren[] = {"MotionBlurPosition"};
+        for (const XMLElement* c = e.FirstChildElement(); c; c = c->NextSiblingElement()) {
+            if (std::string_view(c->Name()) != kChildren[0]) {
+                context_.warn_unknown_element(*c, e, kChildren);
+                continue;
+            }
+            Attributes at(*c, context_);
+            path.push_back(at.vec3(x, y, z));
+            at.warn_unknown();
+            warn_children(*c);
+        }
+    }
+
     void read_sphere(const XMLElement& e) {
         Attributes in(e, context_);
         std::vector<Vec3> path{in.vec3("Px", "Py", "Pz")};
@@ -673,17 +690,7 @@ class SceneReader {
         in.warn_unknown();
         warn_stray_text(e);
 
-        static constexpr std::string_view kChildren[] = {"MotionBlurPosition"};
-        for (const XMLElement* c = e.FirstChildElement(); c; c = c->NextSiblingElement()) {
-            if (std::string_view(c->Name()) != kChildren[0]) {
-                context_.warn_unknown_element(*c, e, kChildren);
-                continue;
-            }
-            Attributes at(*c, context_);
-            path.push_back(at.vec3("Px", "Py", "Pz"));
-            at.warn_unknown();
-            warn_children(*c);
-        }
+        read_motion(e, "Px", "Py", "Pz", path);
         pending_.push_back({&e, std::move(material), std::move(surface),
                             [path = std::move(path), radius](const Material& m, SurfaceDetail d) {
                                 return std::make_unique<Sphere>(path, radius, m, std::move(d));
@@ -725,17 +732,7 @@ class SceneReader {
         SurfaceSpec surface = read_surface(in);
         in.warn_unknown();
         warn_stray_text(e);
-        static constexpr std::string_view kChildren[] = {"MotionBlurPosition"};
-        for (const XMLElement* c = e.FirstChildElement(); c; c = c->NextSiblingElement()) {
-            if (std::string_view(c->Name()) != kChildren[0]) {
-                context_.warn_unknown_element(*c, e, kChildren);
-                continue;
-            }
-            Attributes at(*c, context_);
-            path.push_back(at.vec3("Tx", "Ty", "Tz"));
-            at.warn_unknown();
-            warn_children(*c);
-        }
+        read_motion(e, "Tx", "Ty", "Tz", path);
 
         // Relative to the scene file's folder, as the scene's author sees it.
         const std::filesystem::path obj_path =
