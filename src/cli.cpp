@@ -31,6 +31,7 @@
 #include "drt/render_job.h"
 #include "drt/render_plan.h"
 #include "drt/renderer.h"
+#include "drt/report.h"
 #include "drt/sampler.h"
 #include "drt/scene_loader.h"
 #include "drt/text.h"
@@ -252,6 +253,7 @@ void write_text_atomically(const fs::path& path, const std::string& text) {
 
 struct SceneOutcome {
     std::string scene;
+    fs::path output;
     int status = kOk;
     int width = 0, height = 0, samples = 0;
     double seconds = 0;
@@ -500,6 +502,78 @@ bool is_folder_target(const std::string& output) {
     return !output.empty() && (output.back() == '/' || fs::is_directory(output, ignored));
 }
 
+// --report with --reference-dir: a batch's images against references of the same names.
+struct BatchReport {
+    bool wanted = false;
+    std::string reference_dir;
+    double max_rmse = 0;
+
+    void add_to(CLI::App& app) {
+        CLI::Option* refs =
+            app.add_option("--reference-dir", reference_dir,
+                           "Batch report: the folder of reference images, one per output name");
+        app.add_flag("--report", wanted,
+                     "Batch: compare each image with --reference-dir's and write DIR/report/"
+                     "index.html, worst first")
+            ->needs(refs);
+        app.add_option("--max-rmse", max_rmse,
+                       "Batch report: a case fails when its RMSE exceeds X (default 0: any change)")
+            ->check(CLI::NonNegativeNumber)
+            ->needs(refs);
+    }
+
+    // Writes the report of the batch in `folder` and returns the status it adds: 1 when an image
+    // differs beyond --max-rmse or could not be made, 2 when a reference is missing or unreadable.
+    int write(const std::vector<SceneOutcome>& outcomes, const fs::path& folder, bool quiet,
+              std::ostream& err) const {
+        int status = kOk;
+        std::vector<ReportCase> cases;
+        for (const SceneOutcome& o : outcomes) {
+            const fs::path reference_file = fs::path(reference_dir) / o.output.filename();
+            std::optional<Image> reference, render;
+            std::string note;
+            try {
+                reference = read_image(reference_file);
+            } catch (const ImageError& e) {
+                note = std::string("no reference: ") + e.what();
+                status = std::max(status, kBadInput);
+            }
+            if (o.status == kOk) {
+                try {
+                    render = read_image(o.output);
+                } catch (const ImageError& e) {
+                    note += (note.empty() ? "" : "\n") + std::string(e.what());
+                    status = std::max(status, kFailed);
+                }
+            } else {
+                note += (note.empty() ? "" : "\n") + std::string("the render failed (status ") +
+                        std::to_string(o.status) + ")";
+            }
+            ReportCase c = compare_case(o.output.stem().string(), reference_file.string(),
+                                        o.output.string(), std::move(reference), std::move(render),
+                                        is_linear(format_for_path(o.output)));
+            if (c.measures && !(c.measures->rmse <= max_rmse)) {
+                note += "rmse " + format_measure(c.measures->rmse) + " exceeds --max-rmse " +
+                        format_measure(max_rmse);
+                status = std::max(status, kFailed);
+            } else if (!c.measures && reference && render) {
+                status = std::max(status, kBadInput);  // sizes differ: compare_case says so
+            }
+            c.failed = o.status != kOk || !c.measures || !(c.measures->rmse <= max_rmse);
+            c.note = note + (note.empty() || c.note.empty() ? "" : "\n") + c.note;
+            cases.push_back(std::move(c));
+        }
+        try {
+            const fs::path page = write_report(folder / "report", "drt batch report", cases);
+            if (!quiet) err << "drt: wrote report " << printable(page.string()) << "\n";
+        } catch (const std::exception& e) {
+            err << "drt: report: " << printable(e.what()) << "\n";
+            status = std::max(status, kFailed);
+        }
+        return status;
+    }
+};
+
 int render_command(int argc, const char* const* argv, std::ostream& out, std::ostream& err,
                    const MpiJob* mpi) {
     CLI::App app{
@@ -531,6 +605,8 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
         ->check(CLI::NonNegativeNumber);
     // For tests: stop as SIGINT would once N tiles are done.
     app.add_option("--stop-after-tiles", job.stop_after_tiles)->group("");
+    BatchReport report;
+    report.add_to(app);
     app.set_version_flag("--version", std::string("drt ") + DRT_VERSION);
     try {
         app.parse(argc, argv);
@@ -558,6 +634,10 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
     job.progress = !job.quiet && (force_progress || isatty(STDERR_FILENO));
 
     const bool batch = scenes.size() > 1 || is_folder_target(output);
+    if (report.wanted && !(batch && !output.empty())) {
+        err << "drt: --report needs a batch: -o DIR/\nRun 'drt --help' for usage.\n";
+        return kBadInput;
+    }
     int made = kOk;
     if (job.leader()) {
         for (const std::string& folder : {batch ? output : "", batch ? job.checkpoint : ""}) {
@@ -586,6 +666,7 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
             target = output;
         }
         outcomes.push_back(render_one(scene, target, checkpoint, job, err));
+        outcomes.back().output = target;
         // An interrupt ends the batch: the scenes after it are not started.
         if (outcomes.back().status > kBadInput) break;
     }
@@ -621,6 +702,8 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
         }
     }
     if (batch) print_summary(outcomes, stats == "-" ? err : out);
+    if (report.wanted)
+        status = std::max(status, report.write(outcomes, fs::path(output), job.quiet, err));
     return status;
 }
 
@@ -635,6 +718,10 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
     app.add_option("--min-psnr", min_psnr, "Exit 1 when the PSNR falls below Y (dB)");
     app.add_option("--diff", diff,
                    "Write a false-colour difference image to D (.png, .bmp, .pfm, .exr)");
+    std::string report_dir;
+    app.add_option("--report", report_dir,
+                   "Write DIR/index.html showing B (the reference), A (the render) and their "
+                   "difference with the measures");
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp&) {
@@ -665,8 +752,7 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
         err << "drt compare: out of memory\n";
         return kFailed;
     }
-    out << std::setprecision(6) << "rmse=" << c.rmse << " psnr=" << c.psnr << " ssim=" << c.ssim
-        << " max=" << c.max_abs << " nonfinite=" << c.nonfinite << "\n";
+    out << comparison_fields(c) << "\n";
     int status = kOk;
     if (!diff.empty()) {
         try {
@@ -677,13 +763,37 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
         }
     }
     // Written as "not within" so that a NaN error (a NaN pixel) fails instead of passing.
+    std::string verdict;
     if (max_rmse && !(c.rmse <= *max_rmse)) {
-        err << "drt compare: rmse " << c.rmse << " exceeds --max-rmse " << *max_rmse << "\n";
-        status = kFailed;
+        verdict =
+            "rmse " + format_measure(c.rmse) + " exceeds --max-rmse " + format_measure(*max_rmse);
     }
     if (min_psnr && !(c.psnr >= *min_psnr)) {
-        err << "drt compare: psnr " << c.psnr << " is below --min-psnr " << *min_psnr << "\n";
+        verdict += (verdict.empty() ? "" : "\n") + std::string("psnr ") + format_measure(c.psnr) +
+                   " is below --min-psnr " + format_measure(*min_psnr);
+    }
+    if (!verdict.empty()) {
+        std::istringstream lines(verdict);
+        for (std::string line; std::getline(lines, line);) err << "drt compare: " << line << "\n";
         status = kFailed;
+    }
+    if (!report_dir.empty()) {
+        ReportCase rc{printable(a) + " against " + printable(b),
+                      b,
+                      a,
+                      !verdict.empty(),
+                      verdict,
+                      std::move(image_b),
+                      std::move(image_a),
+                      is_linear(format_for_path(a)),
+                      c};
+        try {
+            const fs::path page = write_report(report_dir, "drt compare", {rc});
+            err << "drt compare: wrote report " << printable(page.string()) << "\n";
+        } catch (const std::exception& e) {
+            err << "drt compare: report: " << printable(e.what()) << "\n";
+            status = kFailed;
+        }
     }
     return status;
 }

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iomanip>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -95,12 +97,6 @@ double pixel_error(const Image& a, const Image& b, std::size_t i) {
     return std::sqrt(sum / 3);
 }
 
-// The inverse of the sRGB curve, so that a colour chosen for display shows as chosen once
-// write_image encodes it again.
-double srgb_to_linear(double v) {
-    return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
-}
-
 }  // namespace
 
 Color false_colour(double t) {
@@ -109,7 +105,8 @@ Color false_colour(double t) {
     const double s = (t > 0 ? std::min(t, 1.0) : 0.0) * (kStops.size() - 1);  // NaN as 0
     const std::size_t k = std::min(static_cast<std::size_t>(s), kStops.size() - 2);
     const Color c = lerp(kStops[k], kStops[k + 1], s - k);
-    return {srgb_to_linear(c.r), srgb_to_linear(c.g), srgb_to_linear(c.b)};
+    // Stored linear, so that the colour shows as chosen once write_image encodes it again.
+    return {decode_srgb(c.r), decode_srgb(c.g), decode_srgb(c.b)};
 }
 
 Comparison compare_images(const Image& a, const Image& b) {
@@ -132,6 +129,18 @@ Comparison compare_images(const Image& a, const Image& b) {
                                    : 20 * std::log10(1 / result.rmse);
     result.ssim = mean_ssim(clamped_luminance(a), clamped_luminance(b), a.width, a.height);
     return result;
+}
+
+std::string format_measure(double value) {
+    std::ostringstream s;
+    s << std::setprecision(6) << value;
+    return s.str();
+}
+
+std::string comparison_fields(const Comparison& c) {
+    return "rmse=" + format_measure(c.rmse) + " psnr=" + format_measure(c.psnr) +
+           " ssim=" + format_measure(c.ssim) + " max=" + format_measure(c.max_abs) +
+           " nonfinite=" + std::to_string(c.nonfinite);
 }
 
 Image difference_image(const Image& a, const Image& b) {

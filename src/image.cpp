@@ -287,6 +287,10 @@ unsigned char encode_srgb8(double linear) {
     return static_cast<unsigned char>(std::lround(encoded * 255));
 }
 
+double decode_srgb(double encoded) {
+    return encoded <= 0.04045 ? encoded / 12.92 : std::pow((encoded + 0.055) / 1.055, 2.4);
+}
+
 void write_image(const Image& image, const fs::path& path, const ImageWriteOptions& options) {
     const ImageFormat format = format_for_path(path);
     if (image.width <= 0 || image.height <= 0) fail(path, "cannot write an empty image");

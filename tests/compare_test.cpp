@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -79,6 +80,40 @@ TEST(CompareImages, SsimOfANoisyCopyIsBetweenZeroAndOne) {
     EXPECT_GT(slight, 0);
     EXPECT_LT(strong, slight);
     EXPECT_GT(strong, 0);
+}
+
+// Flat images have no variance, so only SSIM's luminance term is left: (2ab + C1) / (a² + b² + C1)
+// with C1 = 0.01², for greys a and b (grey's luminance is its value).
+TEST(CompareImages, SsimOfFlatGreysIsItsLuminanceTerm) {
+    const auto flat = [](float v) {
+        Image image(16, 12);
+        std::fill(image.rgb.begin(), image.rgb.end(), v);
+        return image;
+    };
+    const double c1 = 0.01 * 0.01;
+    EXPECT_NEAR(compare_images(flat(0.5f), flat(0.25f)).ssim,
+                (2 * 0.5 * 0.25 + c1) / (0.25 + 0.0625 + c1), 1e-12);
+    EXPECT_NEAR(compare_images(flat(0.0f), flat(1.0f)).ssim, c1 / (1 + c1), 1e-12);
+    // Values beyond [0, 1] are clamped first: 4 counts as 1.
+    EXPECT_NEAR(compare_images(flat(4.0f), flat(0.5f)).ssim, (1 + c1) / (1.25 + c1), 1e-12);
+}
+
+// A flat image against one with texture of the same mean: the luminance term is 1 and the
+// contrast-structure term C2 / (σ² + C2), C2 = 0.03², with σ² the texture's local variance. A
+// checkerboard of 0.5 ± d has σ² = d² in every window (weights summing to 1 over equal numbers of
+// each square only approximately, so the bound is loose).
+TEST(CompareImages, SsimOfAFlatImageAgainstACheckerboardIsItsContrastTerm) {
+    Image flat(32, 32), checker(32, 32);
+    const double d = 0.1;
+    for (int y = 0; y < 32; ++y) {
+        for (int x = 0; x < 32; ++x) {
+            const double v = 0.5 + ((x + y) % 2 ? d : -d);
+            flat.set(x, y, {0.5, 0.5, 0.5});
+            checker.set(x, y, {v, v, v});
+        }
+    }
+    const double c2 = 0.03 * 0.03;
+    EXPECT_NEAR(compare_images(flat, checker).ssim, c2 / (d * d + c2), 2e-3);
 }
 
 TEST(CompareImages, SsimWorksForImagesSmallerThanTheWindow) {

@@ -1,6 +1,7 @@
 // Golden-image regression tests (docs/testing.md): every scene in scenes/ rendered small at a
 // fixed seed must agree with its reference in tests/golden/ within noise, block by block. On a
-// failure the render, the reference and difference images go to golden-diffs/ in the build folder.
+// failure the scene joins the report page golden-diffs/index.html in the build folder (reference,
+// render, difference, measures), whose path the failure message gives.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "drt/compare.h"
+#include "drt/report.h"
 #include "golden.h"
 
 namespace drt {
@@ -31,6 +33,7 @@ golden::Reference flat_reference(int size, float variance) {
 const fs::path kScenes = fs::path(DRT_SOURCE_DIR) / "scenes";
 const fs::path kGolden = fs::path(DRT_SOURCE_DIR) / "tests" / "golden";
 const fs::path kDiffs = DRT_GOLDEN_DIFF_DIR;
+constexpr const char* kReportTitle = "drt golden tests: failing scenes";
 
 fs::path without_extension(fs::path p) {
     return p.replace_extension();
@@ -42,8 +45,7 @@ TEST_P(Golden, MatchesItsReferenceWithinNoise) {
     const fs::path scene = GetParam();
     const fs::path base = kGolden / without_extension(scene);
     const fs::path diff_base = kDiffs / without_extension(scene);
-    for (const char* suffix :
-         {".render.pfm", ".render.png", ".reference.png", ".diff.png", ".z.png"}) {
+    for (const char* suffix : {".render.pfm", ".z.png"}) {
         fs::remove(diff_base.string() + suffix);  // nothing stale from an earlier failure
     }
 
@@ -61,20 +63,26 @@ TEST_P(Golden, MatchesItsReferenceWithinNoise) {
 
     const golden::Verdict verdict = golden::check(render, reference);
     EXPECT_EQ(verdict.nonfinite, 0) << "NaN or infinite pixels in scenes/" << scene.string();
-    if (!verdict.pass) {
-        fs::create_directories(diff_base.parent_path());
-        write_image(render, diff_base.string() + ".render.pfm");
-        write_image(render, diff_base.string() + ".render.png");
-        write_image(reference.mean, diff_base.string() + ".reference.png");
-        write_image(difference_image(render, reference.mean), diff_base.string() + ".diff.png");
-        write_image(golden::z_image(verdict), diff_base.string() + ".z.png");
+    const std::string name = without_extension(scene).string();
+    if (verdict.pass) {
+        remove_report_case(kDiffs, kReportTitle, name);
+        return;
     }
-    EXPECT_TRUE(verdict.pass) << "scenes/" << scene.string() << " no longer matches tests/golden/"
-                              << without_extension(scene).string() << ".pfm: " << verdict.summary()
-                              << "\n  images: " << diff_base.string()
-                              << ".{render,reference,diff,z}.png"
-                              << "\n  if the change is intended, run tools/refresh-goldens.sh "
-                              << scene.string() << " and commit what it prints";
+    fs::create_directories(diff_base.parent_path());
+    write_image(render, diff_base.string() + ".render.pfm");
+    write_image(golden::z_image(verdict), diff_base.string() + ".z.png");
+    // The report shares the page with every other failing scene's, worst first.
+    ReportCase c = compare_case(name, (base.string() + ".pfm"), diff_base.string() + ".render.pfm",
+                                reference.mean, render, true);
+    c.failed = true;
+    c.note = verdict.summary() +
+             "\nz map (each 4 x 4 block by its |z|, red at the bound): " + diff_base.string() +
+             ".z.png";
+    const fs::path page = add_report_case(kDiffs, kReportTitle, c);
+    ADD_FAILURE() << "scenes/" << scene.string() << " no longer matches tests/golden/" << name
+                  << ".pfm: " << verdict.summary() << "\n  report: " << page.string()
+                  << "\n  if the change is intended, run tools/refresh-goldens.sh "
+                  << scene.string() << " and commit what it prints";
 }
 
 std::string test_name(const ::testing::TestParamInfo<fs::path>& info) {

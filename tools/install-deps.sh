@@ -5,9 +5,10 @@
 #   --bench  also libbenchmark-dev, povray and time, which bench/ needs (docs/performance.md)
 set -euo pipefail
 
-# Open MPI: drt runs under mpirun across processes and machines (docs/usage.md); its tests need both.
+# openexr (exrheader) and chromium (a headless browser loading the regression reports) are for the
+# tests; Open MPI: drt runs under mpirun across processes and machines (docs/usage.md).
 packages=(g++ cmake make pkg-config libtinyxml2-dev libstb-dev libcli11-dev libopenexr-dev
-          libgtest-dev openexr clang-14 libclang-rt-14-dev libopenmpi-dev openmpi-bin)
+          libgtest-dev openexr chromium clang-14 libclang-rt-14-dev libopenmpi-dev openmpi-bin)
 for arg in "$@"; do
     case "$arg" in
         --study) packages+=(gnuplot-nox) ;;

@@ -7,14 +7,24 @@ cd "$(dirname "$0")/.."
 tools/install-deps.sh
 jobs=$(nproc)
 
+# A failing golden test adds its scene to one report page; say where it is.
+run_tests() {
+    if ! (cd "$1" && ctest --output-on-failure -j"$jobs"); then
+        if [ -f "$1/golden-diffs/index.html" ]; then
+            echo "golden-image report: $PWD/$1/golden-diffs/index.html" >&2
+        fi
+        exit 1
+    fi
+}
+
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$jobs"
-(cd build && ctest --output-on-failure -j"$jobs")
+run_tests build
 
 cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDRT_SANITIZE=ON -DDRT_PORTABLE=ON \
     >/dev/null
 cmake --build build-sanitize -j"$jobs"
-(cd build-sanitize && ctest --output-on-failure -j"$jobs")
+run_tests build-sanitize
 
 tools/compare-builds.sh build/drt build-sanitize/drt
 

@@ -1,6 +1,8 @@
 // Image comparison for regression tests: error measures and a false-colour difference image.
 #pragma once
 
+#include <string>
+
 #include "drt/image.h"
 
 namespace drt {
@@ -16,6 +18,12 @@ struct Comparison {
 // Throws ImageError when the sizes differ. A NaN anywhere makes rmse, psnr and max_abs NaN, so
 // that no tolerance can accept it.
 Comparison compare_images(const Image& a, const Image& b);
+
+// A measure as drt compare prints it (6 significant digits, "inf", "nan"); reports show the same.
+std::string format_measure(double value);
+
+// drt compare's line: "rmse=<x> psnr=<y> ssim=<z> max=<w> nonfinite=<n>".
+std::string comparison_fields(const Comparison& c);
 
 // A display colour for t in [0, 1]: black, blue, green, yellow, red at equal steps, stored
 // linear so that it shows as such once written to an 8-bit (sRGB-encoded) file.

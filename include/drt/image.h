@@ -59,6 +59,9 @@ ImageFormat format_for_path(const std::filesystem::path& path);
 // sRGB transfer curve of a linear value clamped to [0, 1], rounded to 8 bits.
 unsigned char encode_srgb8(double linear);
 
+// The inverse of the sRGB curve: the linear value of an encoded one in [0, 1].
+double decode_srgb(double encoded);
+
 // Writes .png/.bmp (8-bit sRGB-encoded), .pfm or .exr (linear float). The file appears complete or
 // not at all: data goes to a temporary file in the same folder, which is then renamed.
 void write_image(const Image& image, const std::filesystem::path& path,
