@@ -684,16 +684,6 @@ TEST_F(CompareCliTest, DiffWritesAFalseColourImageOfTheSameSize) {
 
 // ---- OpenEXR ------------------------------------------------------------------------------------
 
-// Runs a shell command line and returns its standard output.
-std::string shell_output(const std::string& command) {
-    std::string text;
-    const std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(command.c_str(), "r"), pclose);
-    if (!pipe) return text;
-    char buf[4096];
-    for (std::size_t n; (n = fread(buf, 1, sizeof buf, pipe.get())) > 0;) text.append(buf, n);
-    return text;
-}
-
 TEST_F(CliTest, ExrOutputHasTheRendersFloatsAndSaysHowItWasMade) {
     ASSERT_EQ(
         run({"scene.xml", "-q", "--spp", "3", "--seed", "11", "--sampler", "sobol", "-o", "a.exr"})

@@ -147,15 +147,6 @@ TEST_F(ReportTest, CasesAddedAtOnceByManyProcessesAreAllKeptAndRemovingTheLastRe
 
 // ---- in a browser -----------------------------------------------------------------------------
 
-std::string shell_output(const std::string& command) {
-    std::string text;
-    const std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(command.c_str(), "r"), pclose);
-    if (!pipe) return text;
-    char buf[4096];
-    for (std::size_t n; (n = fread(buf, 1, sizeof buf, pipe.get())) > 0;) text.append(buf, n);
-    return text;
-}
-
 bool have_chromium() {
     return std::system("command -v chromium >/dev/null 2>&1") == 0;
 }
@@ -188,7 +179,7 @@ window.addEventListener('load', () => {
     write_bytes(copy, html);
     const fs::path profile = scratch / "chromium-profile";
     fs::create_directories(profile);
-    const std::string dom = shell_output(
+    const std::string dom = test::shell_output(
         "timeout 120 chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
         "--disable-background-networking --disable-component-update --disable-sync "
         "--user-data-dir=" +
