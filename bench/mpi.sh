@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# The scale-out measurements issue 13 asks for, side by side in one run (the variants alternate
+# within each round, so a noisy machine slows each side alike; every ratio is of medians):
+#   overhead: a render under `mpirun -n 1` against the same render without mpirun (want <= 1.02);
+#   split:    2 processes x 1 thread against 1 process x 2 threads, as speed (want >= 0.95);
+#   resume:   a render interrupted half way and resumed from its checkpoint against one run
+#             straight through: the time lost to the cycle.
+# Times are drt's own render seconds (--stats), which leave out process start-up; the wall-clock
+# seconds of the whole command, mpirun's start-up included, are printed beside them.
+# Usage: bench/mpi.sh [--scene FILE] [--scale F] [--rounds N] [--drt PATH]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+drt=build/drt
+scene=scenes/thesis/test1.xml
+scale=0.25
+rounds=3
+while [ $# -gt 0 ]; do
+    case "$1" in
+        --scene) scene=$2; shift 2 ;;
+        --scale) scale=$2; shift 2 ;;
+        --rounds) rounds=$2; shift 2 ;;
+        --drt) drt=$2; shift 2 ;;
+        *) echo "mpi: unknown option $1" >&2; exit 2 ;;
+    esac
+done
+[ -x "$drt" ] || { echo "mpi: no $drt; build first (tools/quickstart.sh)" >&2; exit 2; }
+command -v mpirun >/dev/null || { echo "mpi: needs mpirun: tools/install-deps.sh" >&2; exit 2; }
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+
+field() { grep -o "\"$1\": *[0-9.e+-]*" "$2" | head -1 | sed 's/.*: *//'; }
+median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
+now() { date +%s.%N; }
+# Runs drt (through the command words given before --) and prints "render-seconds wall-seconds".
+timed() {
+    local launcher=()
+    while [ "$1" != "--" ]; do launcher+=("$1"); shift; done
+    shift
+    local start status
+    start=$(now)
+    status=0
+    "${launcher[@]}" "$drt" "$scene" --scale "$scale" -q --stats "$out/s.json" -o "$out/x.pfm" "$@" ||
+        status=$?
+    [ "$status" -eq 0 ] || [ "$status" -eq 130 ] || { echo "mpi: drt exited $status" >&2; exit 1; }
+    echo "$(field seconds "$out/s.json" 2>/dev/null || echo 0) $(awk -v a="$start" -v b="$(now)" 'BEGIN { print b - a }')"
+}
+mpi() { echo mpirun --oversubscribe -n "$1"; }
+
+# Tiles in the image, for an interrupt half way.
+size=$("$drt" info "$scene" --scale "$scale" | sed -n 's/^image: *\([0-9]*\)x\([0-9]*\).*/\1x\2/p')
+width=${size%x*} height=${size#*x}
+half=$(( ((width + 15) / 16) * ((height + 15) / 16) / 2 ))
+
+for v in plain mpi1 one2 two1 straight cycle; do : >"$out/$v.r"; : >"$out/$v.w"; done
+for round in $(seq "$rounds"); do
+    echo "round $round of $rounds ..." >&2
+    record() { read -r r w <<<"$2"; echo "$r" >>"$out/$1.r"; echo "$w" >>"$out/$1.w"; }
+    record plain "$(timed -- --threads 1)"
+    record mpi1 "$(timed $(mpi 1) -- --threads 1)"
+    record one2 "$(timed -- --threads 2)"
+    record two1 "$(timed $(mpi 2) -- --threads 1)"
+    record straight "$(timed -- --threads 2 --checkpoint "$out/c.ckpt")"
+    read -r r1 w1 <<<"$(timed -- --threads 2 --checkpoint "$out/c.ckpt" --stop-after-tiles "$half")"
+    read -r r2 w2 <<<"$(timed -- --threads 2 --checkpoint "$out/c.ckpt")"
+    record cycle "$(awk -v a="$r1" -v b="$r2" -v c="$w1" -v d="$w2" 'BEGIN { print a + b, c + d }')"
+done
+m() { median <"$out/$1.$2"; }
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.3f", a / b }'; }
+echo "scene $scene at --scale $scale (${width}x${height}, $(( half * 2 )) tiles), $rounds rounds; medians"
+printf '%-44s %10s %10s\n' "" "render s" "wall s"
+for v in "plain:1 process x 1 thread, no mpirun" "mpi1:mpirun -n 1, 1 thread" \
+         "one2:1 process x 2 threads" "two1:mpirun -n 2, 1 thread each" \
+         "straight:straight through (--checkpoint)" "cycle:stopped half way + resumed"; do
+    printf '%-44s %10.3f %10.3f\n' "${v#*:}" "$(m "${v%%:*}" r)" "$(m "${v%%:*}" w)"
+done
+echo "overhead: MPI path / plain (render seconds)           $(ratio "$(m mpi1 r)" "$(m plain r)")   want <= 1.02"
+echo "split:    speed of 2 x 1 thread / 1 x 2 threads       $(ratio "$(m one2 r)" "$(m two1 r)")   want >= 0.95"
+echo "resume:   interrupt-and-resume / straight (render s)  $(ratio "$(m cycle r)" "$(m straight r)")"
+echo "resume:   seconds lost to the cycle (wall)            $(awk -v a="$(m cycle w)" -v b="$(m straight w)" 'BEGIN { printf "%.3f", a - b }')"
