@@ -105,7 +105,7 @@ Bytes encode_exr(const Image& image, const ImageWriteOptions& options, const fs:
                                               x_stride, y_stride));
         }
         MemoryOStream stream(file, path);
-        Imf::OutputFile out(stream, header, 1);
+        Imf::OutputFile out(stream, header, 0);
         out.setFrameBuffer(frame);
         out.writePixels(image.height);
     } catch (const std::exception& e) {
@@ -122,7 +122,8 @@ Image decode_exr(const Bytes& data, const fs::path& path) {
     // OpenEXR reports everything, from a bad magic number to a truncated tile, by throwing.
     try {
         MemoryIStream stream(data, path);
-        Imf::InputFile in(stream, 1);
+        // No worker threads: a pool costs a thread start per file and one worker gains nothing.
+        Imf::InputFile in(stream, 0);
         const Imath::Box2i window = in.header().dataWindow();
         const long long w = static_cast<long long>(window.max.x) - window.min.x + 1;
         const long long h = static_cast<long long>(window.max.y) - window.min.y + 1;

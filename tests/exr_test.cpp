@@ -171,12 +171,16 @@ TEST_F(ExrTest, AnImageWithoutColourChannelsIsRefused) {
 TEST_F(ExrTest, TruncatedOrCorruptFilesThrowImageErrors) {
     write_image(awkward_image(16, 8), file("a.exr"));
     const std::string bytes = read_bytes(file("a.exr"));
+    // The thousands of variants are decoded from memory: the decoder is what they test, and
+    // rewriting a file that many times costs minutes on a disk mounted with `discard`.
     const fs::path bad = file("bad.exr");
+    const auto decode = [&](const std::string& data) {
+        decode_exr(std::vector<unsigned char>(data.begin(), data.end()), bad);
+    };
     for (std::size_t keep = 0; keep < bytes.size(); ++keep) {
         SCOPED_TRACE("cut to " + std::to_string(keep) + " of " + std::to_string(bytes.size()));
-        write_bytes(bad, bytes.substr(0, keep));
         try {
-            read_image(bad);
+            decode(bytes.substr(0, keep));
             FAIL() << "no exception";
         } catch (const ImageError& e) {
             EXPECT_EQ(std::string(e.what()).rfind(bad.string() + ": ", 0), 0u) << e.what();
@@ -190,17 +194,18 @@ TEST_F(ExrTest, TruncatedOrCorruptFilesThrowImageErrors) {
         for (const unsigned char v : {0x00, 0x7f, 0xff}) {
             std::string changed = bytes;
             changed[i] = static_cast<char>(v);
-            write_bytes(bad, changed);
             try {
-                read_image(bad);
+                decode(changed);
             } catch (const ImageError&) {
                 ++refused;
             }
         }
     }
     EXPECT_GT(refused, 50);
+    // Through the file reader too: a cut file and garbage.
     for (const std::string& garbage :
-         {std::string("v/1\x01"), std::string(100, '\0'), std::string("hello"), std::string()}) {
+         {bytes.substr(0, bytes.size() / 2), std::string("v/1\x01"), std::string(100, '\0'),
+          std::string("hello"), std::string()}) {
         write_bytes(bad, garbage);
         EXPECT_THROW(read_image(bad), ImageError);
     }
