@@ -28,6 +28,7 @@
 #include "drt/interrupt.h"
 #include "drt/limits.h"
 #include "drt/mpi_work.h"
+#include "drt/progressive.h"
 #include "drt/render_job.h"
 #include "drt/render_plan.h"
 #include "drt/renderer.h"
@@ -211,7 +212,23 @@ std::string json_string(const std::string& s) {
     return out + "\"";
 }
 
-std::string stats_json(const Scene& scene, const RenderResult& r) {
+// The rounds of a render to a goal (--target-error, --time-limit).
+std::string goal_json(const ProgressiveResult& p, const std::optional<double>& target,
+                      const std::optional<double>& limit) {
+    std::ostringstream j;
+    j << "  \"goal\": {\"target_error\": " << (target ? json_number(*target) : "null")
+      << ", \"time_limit\": " << (limit ? json_number(*limit) : "null")
+      << ", \"target_met\": " << json_bool(p.target_met) << ", \"rounds\": [";
+    for (std::size_t i = 0; i < p.rounds.size(); ++i) {
+        const ProgressiveRound& r = p.rounds[i];
+        j << (i ? ", " : "") << "{\"spp\": " << r.spp << ", \"seconds\": " << json_number(r.seconds)
+          << ", \"estimated_rmse\": " << (r.error ? json_number(*r.error) : "null") << "}";
+    }
+    j << "]},\n";
+    return j.str();
+}
+
+std::string stats_json(const Scene& scene, const RenderResult& r, const std::string& goal = {}) {
     const RayCounts& rays = r.stats.rays;
     const Effects& e = r.plan.effects;
     const RenderSettings& s = scene.settings;
@@ -237,6 +254,7 @@ std::string stats_json(const Scene& scene, const RenderResult& r) {
           << ", \"min_spp\": " << a->min_samples << ", \"max_spp\": " << s.samples
           << ", \"pixels_converged\": " << r.stats.pixels_converged << "},\n";
     }
+    j << goal;
     j << "  \"effects\": {\"antialiasing\": " << json_bool(e.antialiasing)
       << ", \"soft_shadows\": " << json_bool(e.soft_shadows)
       << ", \"glossy_reflection\": " << json_bool(e.glossy_reflection)
@@ -266,7 +284,7 @@ struct AdaptiveFlags {
     std::optional<double> noise_threshold;
     int min_spp = 16;
 
-    void add_to(CLI::App& app) {
+    CLI::Option* add_to(CLI::App& app) {
         CLI::Option* threshold =
             app.add_option("--noise-threshold", noise_threshold,
                            "Adaptive sampling: a pixel stops once the standard error of its mean "
@@ -276,6 +294,7 @@ struct AdaptiveFlags {
                        "Adaptive sampling: samples every pixel takes first (default 16)")
             ->check(integer_in(1, kMaxSamples))
             ->needs(threshold);
+        return threshold;
     }
     std::optional<AdaptiveSampling> settings() const {
         if (!noise_threshold) return std::nullopt;
@@ -283,9 +302,33 @@ struct AdaptiveFlags {
     }
 };
 
+// --target-error and --time-limit: rounds of renders until the goal (progressive.h).
+struct GoalFlags {
+    std::optional<double> target_error, time_limit;
+
+    // `conflicting`: options that cannot go with a goal.
+    void add_to(CLI::App& app, const std::vector<CLI::Option*>& conflicting) {
+        CLI::Option* target =
+            app.add_option("--target-error", target_error,
+                           "Render until the image's estimated RMSE is at most E; --spp is then "
+                           "the maximum")
+                ->check(finite_positive());
+        CLI::Option* limit =
+            app.add_option("--time-limit", time_limit,
+                           "Render the best image that S seconds allow; --spp is then the maximum")
+                ->check(finite_positive());
+        for (CLI::Option* other : conflicting) {
+            target->excludes(other);
+            limit->excludes(other);
+        }
+    }
+    bool wanted() const { return target_error || time_limit; }
+};
+
 struct RenderJob {
     Overrides overrides;
     AdaptiveFlags adaptive;
+    GoalFlags goal;
     int threads = 0;
     bool quiet = false;
     bool progress = false;
@@ -349,6 +392,26 @@ class SignalStop {
     std::jthread poller_;  // last: stopped and joined before the rest goes
 };
 
+// What a render to a goal reached, and how to render the same image again.
+std::string goal_summary(const std::string& name, const ProgressiveResult& p, const GoalFlags& goal,
+                         double seconds) {
+    std::ostringstream line;
+    line << "drt: " << name << ": " << p.samples << " spp after rounds of ";
+    for (std::size_t i = 0; i < p.rounds.size(); ++i) line << (i ? ", " : "") << p.rounds[i].spp;
+    line << " spp; estimated rmse " << (p.error ? short_number(*p.error) : std::string("n/a"));
+    if (goal.target_error) {
+        line << " (target " << short_number(*goal.target_error)
+             << (p.target_met ? " met)" : " not met)");
+    }
+    if (goal.time_limit) {
+        line << "; " << std::fixed << std::setprecision(2) << seconds << " s of the "
+             << short_number(*goal.time_limit) << " s limit" << std::defaultfloat;
+    }
+    line << "\ndrt: " << name << ": --spp " << p.samples
+         << " renders the same image (bit-identical) without a goal\n";
+    return line.str();
+}
+
 // `<stem>.partial.<ext>` beside the output: an interrupted render's finished tiles.
 fs::path partial_path(const fs::path& output) {
     return output.parent_path() /
@@ -386,6 +449,7 @@ int guarded(const std::string& name, std::ostream& err, Step&& step) {
 SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
                         const std::optional<fs::path>& checkpoint, const RenderJob& job,
                         std::ostream& err) {
+    const auto start = std::chrono::steady_clock::now();  // a time limit counts from here
     SceneOutcome outcome;
     outcome.scene = scene_path;
     const std::string name = printable(scene_path);
@@ -395,7 +459,9 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
         loaded.emplace(load_scene(scene_path));
         for (const std::string& w : loaded->warnings) err << w << "\n";
         job.overrides.apply(loaded->scene.settings);
-        if (const auto problem = render_limit_problem(loaded->scene.settings, job.threads)) {
+        RenderSettings largest = loaded->scene.settings;
+        if (job.goal.wanted() && !job.overrides.spp) largest.samples = kMaxSamples;
+        if (const auto problem = render_limit_problem(largest, job.threads)) {
             throw LimitError(*problem);
         }
     });
@@ -420,7 +486,23 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
         options.on_progress = [&](double done) { (*display)(done); };
     }
     RenderJobResult r;
-    status = guarded(name, err, [&] { r = run_render_job(scene, options); });
+    std::optional<ProgressiveResult> rounds;
+    status = guarded(name, err, [&] {
+        if (!job.goal.wanted()) {
+            r = run_render_job(scene, options);
+            return;
+        }
+        ProgressiveGoal goal;
+        goal.target_error = job.goal.target_error;
+        goal.time_limit = job.goal.time_limit;
+        goal.max_samples = job.overrides.spp.value_or(kMaxSamples);
+        goal.start = start;
+        rounds = render_progressively(loaded->scene, options, goal);
+        r = std::move(rounds->job);
+        loaded->scene.settings.samples = rounds->samples;
+        r.render.stats.seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    });
     if (status != kOk || !job.leader()) {
         outcome.status = job.agree(status);
         return outcome;
@@ -453,7 +535,9 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
         outcome.status = job.agree(sig != 0 ? 128 + sig : kInterrupted);
         return outcome;
     }
-    outcome.json = stats_json(scene, result);
+    outcome.json = stats_json(
+        scene, result,
+        rounds ? goal_json(*rounds, job.goal.target_error, job.goal.time_limit) : std::string());
     if (checkpoint) {
         std::error_code ignored;
         fs::remove(*checkpoint, ignored);
@@ -466,6 +550,14 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
             << std::setprecision(2) << outcome.seconds << " s";
         if (r.resumed > 0) err << ", " << r.resumed << " of " << r.tiles << " tiles resumed";
         err << ")\n" << std::defaultfloat;
+        if (rounds) err << goal_summary(name, *rounds, job.goal, outcome.seconds);
+    }
+    if (rounds && rounds->stopped) {
+        // Interrupted between or during rounds: the image is the last complete round's.
+        const int sig = stop_signal().load();
+        err << "drt: " << name << ": interrupted; kept the last complete round\n";
+        outcome.status = job.agree(sig != 0 ? 128 + sig : kInterrupted);
+        return outcome;
     }
     // Written all the same, for inspection, but not a success: no pixel may be silently lost.
     if (const std::size_t bad = count_nonfinite(result.image)) {
@@ -591,15 +683,17 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
     app.add_flag("--exr-half", job.exr_half,
                  "Write .exr channels as 16-bit half floats instead of 32-bit floats");
     job.overrides.add_to(app);
-    job.adaptive.add_to(app);
+    CLI::Option* threshold = job.adaptive.add_to(app);
     app.add_option("--threads", job.threads, "Worker threads (default: all cores)")
         ->check(integer_in(1, kMaxThreads));
     app.add_option("--stats", stats, "Write render statistics as JSON to FILE (- = stdout)");
     app.add_flag("-q,--quiet", job.quiet, "No progress display or messages besides errors");
     app.add_flag("--progress", force_progress, "Show progress even when stderr is not a terminal");
-    app.add_option("--checkpoint", job.checkpoint,
-                   "Keep finished work in FILE (with several scenes, a folder); running the same "
-                   "command again resumes from it; removed when the render completes");
+    CLI::Option* checkpoint =
+        app.add_option("--checkpoint", job.checkpoint,
+                       "Keep finished work in FILE (with several scenes, a folder); running the "
+                       "same command again resumes from it; removed when the render completes");
+    job.goal.add_to(app, {threshold, checkpoint});
     app.add_option("--checkpoint-every", job.checkpoint_seconds,
                    "Seconds between checkpoint writes (default 30)")
         ->check(CLI::NonNegativeNumber);

@@ -24,19 +24,6 @@ void require_same_size(const Image& a, const Image& b) {
     }
 }
 
-// Restores a scene's settings however the render ends.
-class SettingsGuard {
-  public:
-    explicit SettingsGuard(Scene& scene) : scene_(scene), saved_(scene.settings) {}
-    ~SettingsGuard() { scene_.settings = saved_; }
-    SettingsGuard(const SettingsGuard&) = delete;
-    SettingsGuard& operator=(const SettingsGuard&) = delete;
-
-  private:
-    Scene& scene_;
-    RenderSettings saved_;
-};
-
 }  // namespace
 
 double rmse(const Image& image, const Image& reference) {

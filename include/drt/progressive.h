@@ -1,0 +1,72 @@
+// Rendering to a goal instead of a sample count: until the image's estimated error reaches a
+// target (--target-error), or for as long as a time budget allows (--time-limit). Each round is
+// a complete render at one sample count, so the image kept is always bit-identical to the plain
+// render `--spp N` of the count N it reached, for every sampler (a stratified pattern of N
+// samples does not extend one of fewer, so rounds do not continue one another's samples). The
+// counts are chosen on the leader from the rounds' estimated errors and times and shared with
+// every process, so a goal of error alone gives the same bits for any --threads and any number
+// of processes; a time budget stops where the machine's speed lets it.
+#pragma once
+
+#include <chrono>
+#include <optional>
+#include <vector>
+
+#include "drt/render_job.h"
+#include "drt/scene.h"
+
+namespace drt {
+
+struct ProgressiveGoal {
+    std::optional<double> target_error;  // estimated RMSE to reach
+    std::optional<double> time_limit;    // seconds from `start`
+    int max_samples = 0;                 // per pixel, never more (--spp)
+    std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+};
+
+// One complete render of the sequence.
+struct ProgressiveRound {
+    int spp = 0;
+    double seconds = 0;           // its wall-clock time
+    std::optional<double> error;  // its estimated RMSE; absent where it cannot be estimated
+};
+
+// Samples per pixel and time a render needs to reach an error, extrapolated from rounds.
+struct Prediction {
+    int spp = 0;
+    double seconds = 0;
+};
+
+// The count at which the error of the last two rounds with an estimate, extrapolated along
+// their log-log slope (held between -1 and -1/4: pilots are noisy), falls to `target`, with
+// 10 % to spare, at most `max_samples`; the time from a line through the rounds' times. Absent
+// when fewer than two rounds have a positive estimate.
+std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, double target,
+                                  int max_samples);
+
+// Seconds a render of `spp` samples takes, from a line (set-up plus a cost per sample) through
+// the last two rounds' times; from the last round alone when there is one.
+double predicted_seconds(const std::vector<ProgressiveRound>& rounds, int spp);
+
+struct ProgressiveResult {
+    RenderJobResult job;          // the image kept: the last complete round's
+    int samples = 0;              // its samples per pixel: `--spp samples` renders the same bits
+    std::optional<double> error;  // its estimated RMSE
+    std::vector<ProgressiveRound> rounds;
+    bool target_met = false;
+    bool stopped = false;  // a signal (options.stop) ended it; job may be incomplete
+};
+
+// The pilot rounds' counts: small enough to cost little next to the render, large enough for a
+// batch estimate of the error.
+inline constexpr int kPilotSamples[] = {8, 32};
+
+// Collective under MPI. Rounds at the pilot counts, then at the predicted count (for a time
+// budget the largest predicted to fit, with a tenth to spare) until the goal is met, the budget
+// is spent or the next round would pass max_samples. A round still running when the budget runs
+// out is stopped and dropped. options.checkpoint must be absent. The scene's sample count is
+// changed during the rounds and restored afterwards.
+ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& options,
+                                       const ProgressiveGoal& goal);
+
+}  // namespace drt
