@@ -1,0 +1,173 @@
+// Rendering to a goal (progressive.h): the prediction's arithmetic, and --target-error and
+// --time-limit as a user runs them.
+#include "drt/progressive.h"
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "drt/converge.h"
+#include "run_drt.h"
+
+namespace drt {
+namespace {
+
+namespace fs = std::filesystem;
+using test::Outcome;
+using test::read_bytes;
+using test::run_drt;
+
+TEST(Predict, ExtrapolatesTheLastTwoErrorsAlongTheirSlopeWithATenthToSpare) {
+    // Error halving from 8 to 32 samples: slope -1/2, so a quarter of the error needs 16 times
+    // the samples: 32 * 16 * 1.1 = 563.2.
+    const std::vector<ProgressiveRound> rounds{{8, 1.0, 0.08}, {32, 2.5, 0.04}};
+    const auto p = predict(rounds, 0.01, 65536);
+    ASSERT_TRUE(p);
+    EXPECT_EQ(p->spp, 564);
+    // Time: 0.5 s of set-up and 1.5 s / 24 samples = 0.0625 s a sample.
+    EXPECT_DOUBLE_EQ(p->seconds, 0.5 + 0.0625 * 564);
+    // Met already: the last count.
+    EXPECT_EQ(predict(rounds, 0.05, 65536)->spp, 32);
+    // Capped at the maximum.
+    EXPECT_EQ(predict(rounds, 0.01, 100)->spp, 100);
+}
+
+TEST(Predict, HoldsTheSlopeBetweenMinusOneAndMinusAQuarter) {
+    // A flat pair of pilots (slope 0) is taken as -1/4: half the error needs 16 times the samples.
+    const std::vector<ProgressiveRound> flat{{8, 1, 0.08}, {32, 2, 0.08}};
+    EXPECT_EQ(predict(flat, 0.04, 65536)->spp, static_cast<int>(std::ceil(32 * 16 * 1.1)));
+    // A slope of -2 (luck) is taken as -1: half the error needs twice the samples.
+    const std::vector<ProgressiveRound> steep{{8, 1, 0.16}, {16, 2, 0.04}};
+    EXPECT_EQ(predict(steep, 0.02, 65536)->spp, static_cast<int>(std::ceil(16 * 2 * 1.1)));
+}
+
+TEST(Predict, NeedsTwoRoundsWithAnEstimate) {
+    EXPECT_FALSE(predict({{8, 1, 0.08}}, 0.01, 65536));
+    EXPECT_FALSE(predict({{8, 1, std::nullopt}, {32, 2, 0.04}}, 0.01, 65536));
+    EXPECT_FALSE(predict({{8, 1, 0.0}, {32, 2, 0.0}}, 0.01, 65536));
+}
+
+TEST(PredictedSeconds, ALineThroughTheLastTwoRoundsOrProportionalToOne) {
+    EXPECT_DOUBLE_EQ(predicted_seconds({{10, 2.0, {}}}, 100), 20.0);
+    EXPECT_DOUBLE_EQ(predicted_seconds({{10, 2.0, {}}, {20, 3.0, {}}}, 100), 1.0 + 0.1 * 100);
+    // Times that fall with samples (noise) never predict a free sample: the last round's rate.
+    EXPECT_DOUBLE_EQ(predicted_seconds({{10, 3.0, {}}, {20, 2.0, {}}}, 100), 10.0);
+}
+
+// ---- the command line --------------------------------------------------------------------------
+
+// Soft shadows and antialiasing; renders in milliseconds.
+constexpr const char* kScene = R"(<?xml version="1.0"?>
+<Scene>
+  <Image Width="24" Height="16"/>
+  <Render Samples="4" ShadowRays="1" Seed="3"/>
+  <Background r="0.1" g="0.2" b="0.3"/>
+  <Camera Ex="0" Ey="2" Ez="-8" Lx="0" Ly="1" Lz="0" Fov="40"/>
+  <Materials>
+    <Grey kdr="0.7" kdg="0.7" kdb="0.7" diffuse="1"/>
+  </Materials>
+  <Light Px="2" Py="6" Pz="-2" Radius="0.8" Ir="1" Ig="1" Ib="1"/>
+  <Plane Px="0" Py="0" Pz="0" Vu="0" Vv="1" Vw="0" Material="Grey"/>
+  <Sphere Px="0" Py="1" Pz="0" Radius="1" Material="Grey"/>
+</Scene>
+)";
+
+class GoalCli : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir_ = fs::temp_directory_path() /
+               ("drt_goal_test_" + std::to_string(getpid()) + "_" + info->name());
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+        test::write_bytes(dir_ / "scene.xml", kScene);
+    }
+    void TearDown() override {
+        if (!HasFailure()) fs::remove_all(dir_);
+    }
+    Outcome run(const std::vector<std::string>& args) const { return run_drt(args, dir_); }
+    std::string bytes(const std::string& name) const { return read_bytes(dir_ / name); }
+    // N of the "--spp N renders the same image" line.
+    static int reached(const std::string& err) {
+        std::smatch m;
+        const std::regex spp(": --spp (\\d+) renders the same image");
+        return std::regex_search(err, m, spp) ? std::stoi(m[1]) : -1;
+    }
+
+    fs::path dir_;
+};
+
+TEST_F(GoalCli, BadGoalsExitTwoWithTheReasonAndWriteNothing) {
+    for (const std::string option : {"--target-error", "--time-limit"}) {
+        for (const std::string value : {"0", "-1", "nan", "inf", "x"}) {
+            const Outcome r =
+                run({"scene.xml", option, value, "-o", "out.pfm", "--stats", "s.json"});
+            EXPECT_EQ(r.status, 2) << option << " " << value;
+            EXPECT_EQ(r.err, "drt: " + option + ": must be a finite positive number, got " + value +
+                                 "\nRun 'drt --help' for usage.\n");
+        }
+    }
+    // A goal decides the sample counts itself: no per-pixel threshold, no checkpoint of rounds.
+    const Outcome threshold =
+        run({"scene.xml", "--target-error", "0.01", "--noise-threshold", "0.1", "-o", "out.pfm"});
+    EXPECT_EQ(threshold.status, 2);
+    EXPECT_EQ(threshold.err,
+              "drt: --noise-threshold excludes --target-error\nRun 'drt --help' for usage.\n");
+    const Outcome checkpoint =
+        run({"scene.xml", "--time-limit", "1", "--checkpoint", "c.ckpt", "-o", "out.pfm"});
+    EXPECT_EQ(checkpoint.status, 2);
+    EXPECT_EQ(checkpoint.err,
+              "drt: --checkpoint excludes --time-limit\nRun 'drt --help' for usage.\n");
+    EXPECT_FALSE(fs::exists(dir_ / "out.pfm"));
+    EXPECT_FALSE(fs::exists(dir_ / "s.json"));
+    EXPECT_FALSE(fs::exists(dir_ / "c.ckpt"));
+}
+
+TEST_F(GoalCli, SppIsTheMaximumAndTheImageIsThePlainRenderOfTheCountReached) {
+    // An error no 40 samples reach: the rounds stop at the maximum.
+    const Outcome r = run({"scene.xml", "--target-error", "1e-9", "--spp", "40", "-o", "goal.pfm",
+                           "--stats", "s.json"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(reached(r.err), 40) << r.err;
+    EXPECT_NE(r.err.find("after rounds of 8, 32, 40 spp"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("(target 1e-09 not met)"), std::string::npos) << r.err;
+    EXPECT_NE(bytes("s.json").find("\"samples_per_pixel\": 40"), std::string::npos);
+    EXPECT_NE(bytes("s.json").find("\"target_met\": false"), std::string::npos);
+    ASSERT_EQ(run({"scene.xml", "--spp", "40", "-o", "plain.pfm", "-q"}).status, 0);
+    EXPECT_EQ(bytes("goal.pfm"), bytes("plain.pfm"));
+}
+
+TEST_F(GoalCli, TimeLimitStopsByTheLimitWithThePlainRenderOfTheCountReached) {
+    // The random sampler's time per sample is constant, and 48 tiles let a round be stopped
+    // between tiles. The largest count, 65536 spp, takes minutes: the limit stops the rounds.
+    const std::vector<std::string> size{"--width", "128", "--height", "96", "--sampler", "random"};
+    const double limit = 1.0;
+    std::vector<std::string> args{"scene.xml",   "--time-limit", "1", "-o",
+                                  "limited.pfm", "--threads",    "2"};
+    args.insert(args.end(), size.begin(), size.end());
+    const auto start = std::chrono::steady_clock::now();
+    const Outcome r = run(args);
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ASSERT_EQ(r.status, 0) << r.err;
+    // The limit with 5 % over and a generous allowance for the process's start and end on a
+    // loaded machine; and more than the pilots' 8 + 32 samples.
+    EXPECT_LT(wall, limit * 1.05 + 0.5) << r.err;
+    const int spp = reached(r.err);
+    EXPECT_GT(spp, 32) << r.err;
+    std::vector<std::string> plain{"scene.xml", "--spp",     std::to_string(spp),
+                                   "-o",        "plain.pfm", "-q"};
+    plain.insert(plain.end(), size.begin(), size.end());
+    ASSERT_EQ(run(plain).status, 0);
+    EXPECT_EQ(bytes("limited.pfm"), bytes("plain.pfm"));
+}
+
+}  // namespace
+}  // namespace drt
