@@ -21,15 +21,19 @@ constexpr int kRedrawAttempts = 32;
 // (cos θ = 1 in the cone): a light whose area is not sampled acts as a point there.
 constexpr Vec2 kLightCentre{0, 0};
 
-// The mirror direction about the shading normal, or about the geometric one when a bump has
-// tilted the shading normal so far that the mirror direction would dive below the surface (as
-// refraction falls back below), so an ideal reflection too leaves on the viewer's side.
+}  // namespace
+
 Vec3 reflect_above(const Vec3& d, const Vec3& shading, const Vec3& geometric) {
     const Vec3 r = reflect(d, shading);
     return dot(r, geometric) > 0 ? r : reflect(d, geometric);
 }
 
-}  // namespace
+std::optional<Vec3> refract_below(const Vec3& d, const Vec3& shading, const Vec3& geometric,
+                                  double eta) {
+    const auto through = refract(d, shading, eta);
+    if (through && dot(*through, geometric) < 0) return through;
+    return refract(d, geometric, eta);
+}
 
 Ray spawn_ray(const Vec3& point, const Vec3& normal, const Vec3& dir, double time) {
     const double offset = max_abs_component(point) * 0x1.0p-32 + 1e-9;
@@ -137,10 +141,7 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
                                     +1, ray.time, s, depth, dim::kGlassReflect, false, work);
         }
         if (fresnel < 1) {
-            auto through = refract(ray.dir, shading, eta);
-            if (!through || dot(*through, geometric) >= 0)
-                through = refract(ray.dir, geometric, eta);
-            if (through) {
+            if (const auto through = refract_below(ray.dir, shading, geometric, eta)) {
                 glass += (1.0 - fresnel) * scattered(surface.point, geometric, *through,
                                                      refraction_sigma, -1, ray.time, s, depth,
                                                      dim::kGlossRefract, true, work);

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Renders every thesis scene and single-effect figure at its own settings into docs/images/ and
-# rewrites docs/gallery.md with each image, its settings and its render time on this machine.
+# Renders every thesis scene, single-effect figure and mesh scene at its own settings into
+# docs/images/ and rewrites docs/gallery.md with each image, its settings and its render time on
+# this machine.
 # Usage: tools/render-gallery.sh [extra drt options, e.g. --threads 2]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -25,6 +26,10 @@ declare -A caption=(
     [refraction-n10]="Blurry refraction through a clear sphere (index 1.5, n = 10) in front of a checker wall: frosted glass."
     [refraction-n500]="Refraction with n = 500: nearly clear glass."
     [glass-rim]="An ideal glass sphere (index 1.5) on a checker floor: the Fresnel reflection of the sky-blue background grows towards the rim."
+    [glass-bunny]="Test1's room with the glass sphere replaced by the Stanford bunny (69 451 triangles) in the thesis's Glass made glossy (n 200): blurry refraction, soft shadows of a mesh from two lights."
+    [spot-marble]="Spot the cow (5 856 triangles) in marble on a checker floor, depth of field focused on the cow; a near and a far sphere blur."
+    [moving-teapot]="A porcelain Utah teapot (6 320 triangles) sliding to the right while the shutter is open (motion blur of a mesh), beside a glossy copper teapot standing still."
+    [checker-teapot]="A checker-textured teapot under a red sphere whose soft shadow falls onto it, Spot in bump-mapped glossy gold, and a single Triangle as a glossy mirror behind them."
 )
 
 mkdir -p docs/images
@@ -33,7 +38,7 @@ body=$(mktemp)
 trap 'rm -f "$stats" "$body"' EXIT
 field() { sed -n "s/.*\"$1\": *\([0-9.e+-]*\).*/\1/p" "$stats" | head -n1; }
 
-for scene in scenes/thesis/*.xml scenes/figures/*.xml; do
+for scene in scenes/thesis/*.xml scenes/figures/*.xml scenes/meshes/*.xml; do
     name=$(basename "$scene" .xml)
     build/drt "$scene" -o "docs/images/$name.png" --stats "$stats" -q "$@"
     seconds=$(printf '%.1f' "$(field seconds)")
@@ -54,7 +59,7 @@ done
 {
     echo "# Gallery"
     echo
-    echo "Every thesis scene and single-effect figure of \`scenes/\`, rendered at its own settings"
+    echo "Every thesis scene, single-effect figure and mesh scene of \`scenes/\`, rendered at its own settings"
     echo "by \`tools/render-gallery.sh\` on $(nproc) cores ($(date -u +%F), commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown))."
     echo "Times are wall-clock for the whole render on this machine; see docs/performance.md for"
     echo "side-by-side measurements. Scene details: [scenes/README.md](../scenes/README.md)."

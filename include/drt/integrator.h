@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -37,6 +38,15 @@ Ray spawn_ray(const Vec3& point, const Vec3& normal, const Vec3& dir, double tim
 // A direction about `ideal` whose angle from it is Rayleigh-distributed with scale sigma, i.e.
 // a 2-D normal distribution of standard deviation sigma (radians) on the tangent plane.
 Vec3 perturb_direction(const Vec3& ideal, double sigma, Vec2 u);
+
+// The ideal mirror and refracted directions of `d` (arriving against `geometric`) about the
+// shading normal, unless that would send the ray to the wrong side of the geometric surface —
+// as a bump or a mesh's interpolated normals can at grazing angles, where a reflected ray would
+// enter the object or a refracted one stay outside. Then the geometric normal decides, as for a
+// flat surface. refract_below is empty under total internal reflection.
+Vec3 reflect_above(const Vec3& d, const Vec3& shading, const Vec3& geometric);
+std::optional<Vec3> refract_below(const Vec3& d, const Vec3& shading, const Vec3& geometric,
+                                  double eta);
 
 class Integrator {
   public:
