@@ -19,7 +19,8 @@ namespace {
 using Bytes = std::vector<unsigned char>;
 
 // "DRTCKPT" and a format number: a reader refuses a format it does not know instead of guessing.
-constexpr char kMagic[8] = {'D', 'R', 'T', 'C', 'K', 'P', 'T', '1'};
+// Format 2 added each pixel's spread and each tile's error sums (error_estimate.h).
+constexpr char kMagic[8] = {'D', 'R', 'T', 'C', 'K', 'P', 'T', '2'};
 // The longest version string a reader accepts, so a damaged length cannot ask for gigabytes.
 constexpr std::uint32_t kMaxVersionLength = 256;
 
@@ -32,6 +33,7 @@ class Writer {
     void u32(std::uint32_t v) { put(v, 4); }
     void u64(std::uint64_t v) { put(v, 8); }
     void f32(float v) { u32(std::bit_cast<std::uint32_t>(v)); }
+    void f64(double v) { u64(std::bit_cast<std::uint64_t>(v)); }
     void text(const std::string& s) {
         u32(static_cast<std::uint32_t>(s.size()));
         bytes.insert(bytes.end(), s.begin(), s.end());
@@ -40,6 +42,11 @@ class Writer {
         u64(t.tile.index);
         for (float v : t.pixels.rgb) f32(v);
         for (std::uint32_t n : t.pixel_samples) u32(n);
+        for (float v : t.spread.rgb) f32(v);
+        for (std::size_t k = 0; k < t.error_sums.runs.size(); ++k) {
+            f64(t.error_sums.runs[k]);
+            f64(t.error_sums.runs_pixels[k]);
+        }
         u64(t.rays.camera);
         u64(t.rays.shadow);
         u64(t.rays.reflection);
@@ -63,6 +70,7 @@ class Reader {
     std::uint32_t u32() { return static_cast<std::uint32_t>(get(4)); }
     std::uint64_t u64() { return get(8); }
     float f32() { return std::bit_cast<float>(u32()); }
+    double f64() { return std::bit_cast<double>(u64()); }
     std::string text(std::uint32_t max) {
         const std::uint32_t n = u32();
         if (n > max) fail(file_, "damaged checkpoint (bad text length)");
@@ -83,6 +91,13 @@ class Reader {
         for (float& v : t.pixels.rgb) v = f32();
         t.pixel_samples.resize(static_cast<std::size_t>(t.tile.width()) * t.tile.height());
         for (std::uint32_t& n : t.pixel_samples) n = u32();
+        t.spread = Image(t.tile.width(), t.tile.height());
+        need(t.spread.rgb.size() * 4);
+        for (float& v : t.spread.rgb) v = f32();
+        for (std::size_t k = 0; k < t.error_sums.runs.size(); ++k) {
+            t.error_sums.runs[k] = f64();
+            t.error_sums.runs_pixels[k] = f64();
+        }
         t.rays.camera = u64();
         t.rays.shadow = u64();
         t.rays.reflection = u64();
@@ -108,6 +123,12 @@ class Reader {
     const fs::path& file_;
     std::size_t pos_ = 0;
 };
+
+// A format byte as printed: the digit, or its code when it is not one.
+std::string printable_format(unsigned char c) {
+    if (c >= '0' && c <= '9') return std::string(1, static_cast<char>(c));
+    return "byte " + std::to_string(c);
+}
 
 Bytes read_all(const fs::path& file) {
     std::ifstream in(file, std::ios::binary);
@@ -186,8 +207,15 @@ std::vector<unsigned char> encode_checkpoint(const RenderIdentity& id,
 
 Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<const Tile> grid,
                              const fs::path& file) {
-    if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) {
+    if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic - 1) != 0) {
         fail(file, "not a drt checkpoint");
+    }
+    if (bytes[sizeof kMagic - 1] != static_cast<unsigned char>(kMagic[sizeof kMagic - 1])) {
+        fail(file, std::string("checkpoint format ") + printable_format(bytes[sizeof kMagic - 1]) +
+                       " of another drt version, this one reads format " +
+                       kMagic[sizeof kMagic - 1] +
+                       ": not resumed and nothing written (delete it or name another "
+                       "--checkpoint file)");
     }
     if (bytes.size() < sizeof kMagic + 8) fail(file, "truncated checkpoint");
     const auto body = bytes.first(bytes.size() - 8);

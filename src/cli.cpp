@@ -24,6 +24,7 @@
 #include "drt/checkpoint.h"
 #include "drt/compare.h"
 #include "drt/converge.h"
+#include "drt/error_estimate.h"
 #include "drt/image.h"
 #include "drt/interrupt.h"
 #include "drt/limits.h"
@@ -249,6 +250,14 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
       << json_number(r.stats.seconds > 0 ? rays.total() / r.stats.seconds / 1e6 : 0.0) << ",\n"
       << "  \"mean_spp\": " << json_number(double(r.stats.samples) / (double(s.width) * s.height))
       << ",\n";
+    const ErrorEstimate& error = r.stats.error;
+    if (error.available()) {
+        j << "  \"estimated_rmse\": " << json_number(*error.rmse)
+          << ", \"estimated_relmse\": " << json_number(*error.relmse) << ",\n";
+    } else {
+        j << "  \"estimated_rmse\": null, \"estimated_relmse\": null, \"estimate_unavailable\": "
+          << json_string(error.unavailable) << ",\n";
+    }
     if (const auto& a = r.stats.adaptive) {
         j << "  \"adaptive\": {\"noise_threshold\": " << json_number(a->noise_threshold)
           << ", \"min_spp\": " << a->min_samples << ", \"max_spp\": " << s.samples
@@ -333,7 +342,8 @@ struct RenderJob {
     bool quiet = false;
     bool progress = false;
     bool exr_half = false;
-    std::string checkpoint;  // a file, or with several scenes a folder of <scene>.checkpoint
+    std::string checkpoint;   // a file, or with several scenes a folder of <scene>.checkpoint
+    std::string error_image;  // one scene only: where its per-pixel standard error goes
     double checkpoint_seconds = 30;
     std::optional<std::size_t> stop_after_tiles;
     std::stop_token stop;
@@ -344,8 +354,8 @@ struct RenderJob {
     int agree(int status) const { return mpi ? mpi->highest(status) : status; }
 };
 
-// What an .exr header records about the render, so that the file says how it was made. The
-// render's estimated error (issue 14) belongs here too, as `estimatedError`.
+// What an .exr header records about the render, so that the file says how it was made, and how
+// good it is: `estimatedError`, the estimated RMSE, when there is one.
 ImageWriteOptions output_options(const Scene& scene, const RenderResult& result,
                                  const RenderJob& job) {
     const RenderSettings& s = scene.settings;
@@ -360,6 +370,10 @@ ImageWriteOptions output_options(const Scene& scene, const RenderResult& result,
     if (const auto& a = result.stats.adaptive) {
         options.attributes.push_back({"noiseThreshold", a->noise_threshold});
         options.attributes.push_back({"minSamplesPerPixel", a->min_samples});
+    }
+    if (const auto& rmse = result.stats.error.rmse) {
+        options.attributes.push_back({"estimatedError", *rmse});
+        options.attributes.push_back({"estimatedRelMSE", *result.stats.error.relmse});
     }
     return options;
 }
@@ -538,6 +552,16 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
     outcome.json = stats_json(
         scene, result,
         rounds ? goal_json(*rounds, job.goal.target_error, job.goal.time_limit) : std::string());
+    if (!job.error_image.empty()) {
+        try {
+            write_image(standard_error_image(result.spread, result.stats.error), job.error_image,
+                        output_options(scene, result, job));
+        } catch (const ImageError& e) {
+            err << "drt: " << e.what() << "\n";
+            outcome.status = job.agree(kFailed);
+            return outcome;
+        }
+    }
     if (checkpoint) {
         std::error_code ignored;
         fs::remove(*checkpoint, ignored);
@@ -549,7 +573,9 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
             << outcome.height << ", " << outcome.samples << " spp, " << std::fixed
             << std::setprecision(2) << outcome.seconds << " s";
         if (r.resumed > 0) err << ", " << r.resumed << " of " << r.tiles << " tiles resumed";
-        err << ")\n" << std::defaultfloat;
+        err << ", estimated RMSE "
+            << format_estimate(result.stats.error.rmse, result.stats.error.unavailable) << ")\n"
+            << std::defaultfloat;
         if (rounds) err << goal_summary(name, *rounds, job.goal, outcome.seconds);
     }
     if (rounds && rounds->stopped) {
@@ -687,6 +713,9 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
     app.add_option("--threads", job.threads, "Worker threads (default: all cores)")
         ->check(integer_in(1, kMaxThreads));
     app.add_option("--stats", stats, "Write render statistics as JSON to FILE (- = stdout)");
+    app.add_option("--error-image", job.error_image,
+                   "Write each pixel's estimated standard error (per channel, linear) to FILE "
+                   "(.png, .bmp, .pfm, .exr)");
     app.add_flag("-q,--quiet", job.quiet, "No progress display or messages besides errors");
     app.add_flag("--progress", force_progress, "Show progress even when stderr is not a terminal");
     CLI::Option* checkpoint =
@@ -724,10 +753,26 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
             return job.agree(kBadInput);
         }
     }
+    if (!job.error_image.empty() && job.leader()) {
+        try {
+            format_for_path(job.error_image);
+            check_replaceable(job.error_image);
+        } catch (const ImageError& e) {
+            err << "drt: --error-image " << e.what() << "\n";
+            return job.agree(kBadInput);
+        } catch (const FileWriteError& e) {
+            err << "drt: --error-image " << e.what() << "\n";
+            return job.agree(kBadInput);
+        }
+    }
     if (job.agree(kOk) != kOk) return kBadInput;
     job.progress = !job.quiet && (force_progress || isatty(STDERR_FILENO));
 
     const bool batch = scenes.size() > 1 || is_folder_target(output);
+    if (batch && !job.error_image.empty()) {
+        err << "drt: --error-image takes one scene, not a batch\nRun 'drt --help' for usage.\n";
+        return kBadInput;
+    }
     if (report.wanted && !(batch && !output.empty())) {
         err << "drt: --report needs a batch: -o DIR/\nRun 'drt --help' for usage.\n";
         return kBadInput;
@@ -1023,7 +1068,7 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
         }
         out << std::setw(8) << "spp" << std::setw(11) << "seconds" << std::setw(13) << "rmse"
             << std::setw(13) << "relmse" << std::setw(10) << "mean_spp" << std::setw(13)
-            << "cpu_seconds"
+            << "cpu_seconds" << std::setw(15) << "estimated_rmse" << std::setw(8) << "ratio"
             << "\n";
         const Convergence c =
             measure_convergence(scene, counts, reference, options, [&](const ConvergencePoint& p) {
@@ -1031,8 +1076,15 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
                     << p.seconds << std::defaultfloat << std::setprecision(5) << std::setw(13)
                     << p.rmse << std::setw(13) << p.relmse << std::setprecision(4) << std::setw(10)
                     << p.mean_spp << std::fixed << std::setprecision(3) << std::setw(13)
-                    << p.cpu_seconds << std::defaultfloat
-                    << (p.fitted ? "" : "  (pixel centres: not in the slopes)") << "\n"
+                    << p.cpu_seconds << std::defaultfloat << std::setprecision(5);
+                if (p.estimate.available()) {
+                    out << std::setw(15) << *p.estimate.rmse << std::setprecision(3) << std::setw(8)
+                        << *p.estimate.rmse / p.rmse;
+                } else {
+                    out << "  estimate " << format_estimate({}, p.estimate.unavailable);
+                }
+                out << std::defaultfloat << (p.fitted ? "" : "  (pixel centres: not in the slopes)")
+                    << "\n"
                     << std::flush;
             });
         const auto slope = [](double v) {

@@ -94,6 +94,7 @@ Convergence measure_convergence(Scene& scene, const std::vector<int>& spps, cons
         const double pixels = double(r.image.width) * r.image.height;
         p.mean_spp = pixels > 0 ? r.stats.samples / pixels : 0;
         p.fitted = r.plan.effects.antialiasing || largest == 1;
+        p.estimate = r.stats.error;
         c.points.push_back(p);
         if (on_point) on_point(p);
     }
@@ -112,10 +113,15 @@ Convergence measure_convergence(Scene& scene, const std::vector<int>& spps, cons
 std::string convergence_csv(const Convergence& c) {
     std::ostringstream out;
     out << std::setprecision(9);
-    out << "spp,seconds,rmse,relmse,mean_spp,cpu_seconds,fitted\n";
+    out << "spp,seconds,rmse,relmse,mean_spp,cpu_seconds,fitted,estimated_rmse,estimated_relmse\n";
     for (const ConvergencePoint& p : c.points) {
         out << p.spp << "," << p.seconds << "," << p.rmse << "," << p.relmse << "," << p.mean_spp
-            << "," << p.cpu_seconds << "," << (p.fitted ? 1 : 0) << "\n";
+            << "," << p.cpu_seconds << "," << (p.fitted ? 1 : 0) << ",";
+        if (p.estimate.available())
+            out << *p.estimate.rmse << "," << *p.estimate.relmse;
+        else
+            out << ",";
+        out << "\n";
     }
     return out.str();
 }

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "drt/error_estimate.h"
 #include "drt/rng.h"
 
 namespace drt {
@@ -62,16 +63,24 @@ RenderContext::RenderContext(const Scene& scene, std::optional<AdaptiveSampling>
     }
 }
 
+SpreadKind RenderContext::spread_kind() const {
+    if (sampler_->progressive()) return SpreadKind::kProgressive;
+    return sampler_->independent() ? SpreadKind::kIndependent : SpreadKind::kOther;
+}
+
 TileBuffer RenderContext::render_tile(const Tile& tile) const {
-    TileBuffer buffer{tile, Image(tile.width(), tile.height()), {}, {}, 0, 0};
+    TileBuffer buffer{
+        tile, Image(tile.width(), tile.height()), {}, Image(tile.width(), tile.height()), {}, {}, 0,
+        0};
     buffer.pixel_samples.reserve(static_cast<std::size_t>(tile.width()) * tile.height());
     Scratch scratch;
     scratch.colors.resize(static_cast<std::size_t>(scene_.settings.samples));
     for (int y = tile.y0; y < tile.y1; ++y) {
         for (int x = tile.x0; x < tile.x1; ++x) {
-            const Pixel pixel = adaptive_ ? adaptive_pixel(x, y, scratch, buffer.rays)
-                                          : plain_pixel(x, y, scratch, buffer.rays);
+            const Pixel pixel = adaptive_ ? adaptive_pixel(x, y, scratch, buffer)
+                                          : plain_pixel(x, y, scratch, buffer);
             buffer.pixels.set(x - tile.x0, y - tile.y0, pixel.value);
+            buffer.spread.set(x - tile.x0, y - tile.y0, pixel.spread);
             buffer.pixel_samples.push_back(pixel.samples);
             buffer.samples += pixel.samples;
             buffer.converged += pixel.converged ? 1 : 0;
@@ -81,14 +90,14 @@ TileBuffer RenderContext::render_tile(const Tile& tile) const {
 }
 
 RenderContext::Pixel RenderContext::plain_pixel(int x, int y, Scratch& scratch,
-                                                RayCounts& rays) const {
+                                                TileBuffer& buffer) const {
     const auto spp = static_cast<std::uint32_t>(scene_.settings.samples);
     const PixelSample s{scene_.settings.seed,
                         static_cast<std::uint32_t>(y * scene_.settings.width + x), 0, spp};
-    integrator_.sample_pixel(x, y, s, scratch.colors, rays);
+    integrator_.sample_pixel(x, y, s, scratch.colors, buffer.rays);
     Color sum;
     for (const Color& c : scratch.colors) sum += c;
-    return {sum / spp, spp, false};
+    return {sum / spp, pixel_spread(scratch.colors, spread_kind(), buffer.error_sums), spp, false};
 }
 
 // Rounds of as many samples as taken so far, until the standard error of the mean luminance is
@@ -96,7 +105,7 @@ RenderContext::Pixel RenderContext::plain_pixel(int x, int y, Scratch& scratch,
 // pattern of the round's size, on its own ray-tree path, in each round (the first round is
 // exactly a plain render at the minimum count).
 RenderContext::Pixel RenderContext::adaptive_pixel(int x, int y, Scratch& scratch,
-                                                   RayCounts& rays) const {
+                                                   TileBuffer& buffer) const {
     const auto spp = static_cast<std::uint32_t>(scene_.settings.samples);
     const auto min_spp = static_cast<std::uint32_t>(adaptive_->min_samples);
     const auto pixel = static_cast<std::uint32_t>(y * scene_.settings.width + x);
@@ -105,6 +114,7 @@ RenderContext::Pixel RenderContext::adaptive_pixel(int x, int y, Scratch& scratc
     Color sum;
     bool converged = false;
     luminances.clear();
+    scratch.taken.clear();
     for (std::uint32_t round = 0;; ++round) {
         const auto n = static_cast<std::uint32_t>(luminances.size());
         const std::uint32_t batch = std::min(round == 0 ? min_spp : n, spp - n);
@@ -112,10 +122,11 @@ RenderContext::Pixel RenderContext::adaptive_pixel(int x, int y, Scratch& scratc
         if (!progressive && round > 0) s.path = hash_of(0xada9717eULL, round);
         s.index = progressive ? n : 0;
         scratch.colors.resize(batch);
-        integrator_.sample_pixel(x, y, s, scratch.colors, rays);
+        integrator_.sample_pixel(x, y, s, scratch.colors, buffer.rays);
         for (const Color& c : scratch.colors) {
             sum += c;
             luminances.push_back(luminance(c));
+            scratch.taken.push_back(c);
         }
         if (luminances.size() >= spp) break;
         if (standard_error(luminances, progressive) < adaptive_->noise_threshold) {
@@ -124,7 +135,7 @@ RenderContext::Pixel RenderContext::adaptive_pixel(int x, int y, Scratch& scratc
         }
     }
     const auto n = static_cast<std::uint32_t>(luminances.size());
-    return {sum / n, n, converged};
+    return {sum / n, pixel_spread(scratch.taken, spread_kind(), buffer.error_sums), n, converged};
 }
 
 }  // namespace drt

@@ -108,6 +108,14 @@ RenderResult assembled(const RenderContext& context, const ImageSink& sink) {
     result.stats.samples = sink.samples();
     result.stats.pixels_converged = sink.converged();
     result.unfinished = sink.missing();
+    result.spread = sink.spread();
+    if (result.unfinished.empty()) {
+        result.stats.error =
+            estimate_error(result.image, result.spread, sink.error_sums(),
+                           context.scene().settings.samples, context.spread_kind());
+    } else {
+        result.stats.error.unavailable = "the render is unfinished";
+    }
     return result;
 }
 

@@ -27,6 +27,8 @@ ImageSink::ImageSink(int width, int height, std::vector<Tile> grid)
     : grid_(std::move(grid)),
       image_(width, height),
       pixel_samples_(static_cast<std::size_t>(width) * height, 0),
+      spread_(width, height),
+      error_sums_(grid_.size()),
       done_(grid_.size(), false) {}
 
 void ImageSink::add(TileBuffer buffer) {
@@ -35,7 +37,8 @@ void ImageSink::add(TileBuffer buffer) {
         throw std::invalid_argument("tile " + std::to_string(t.index) + " is not in the grid");
     }
     if (buffer.pixels.width != t.width() || buffer.pixels.height != t.height() ||
-        buffer.pixel_samples.size() != buffer.pixels.rgb.size() / 3) {
+        buffer.pixel_samples.size() != buffer.pixels.rgb.size() / 3 ||
+        buffer.spread.rgb.size() != buffer.pixels.rgb.size()) {
         throw std::invalid_argument("tile " + std::to_string(t.index) +
                                     ": buffer does not match the tile's size");
     }
@@ -50,8 +53,10 @@ void ImageSink::add(TileBuffer buffer) {
         const std::size_t from = static_cast<std::size_t>(y - t.y0) * row;
         const std::size_t to = static_cast<std::size_t>(y) * image_.width + t.x0;
         std::copy_n(buffer.pixels.rgb.begin() + 3 * from, 3 * row, image_.rgb.begin() + 3 * to);
+        std::copy_n(buffer.spread.rgb.begin() + 3 * from, 3 * row, spread_.rgb.begin() + 3 * to);
         std::copy_n(buffer.pixel_samples.begin() + from, row, pixel_samples_.begin() + to);
     }
+    error_sums_[t.index] = buffer.error_sums;
     rays_ += buffer.rays;
     samples_ += buffer.samples;
     converged_ += buffer.converged;
@@ -64,6 +69,13 @@ std::vector<Tile> ImageSink::missing() const {
         if (!done_[t.index]) tiles.push_back(t);
     }
     return tiles;
+}
+
+ErrorSums ImageSink::error_sums() const {
+    const std::lock_guard lock(mutex_);
+    ErrorSums total;
+    for (const ErrorSums& s : error_sums_) total += s;
+    return total;
 }
 
 std::size_t ImageSink::tiles_done() const {

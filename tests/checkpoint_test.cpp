@@ -56,6 +56,10 @@ TileBuffer some_tile(const Tile& tile, float base) {
     t.pixels = Image(tile.width(), tile.height());
     for (std::size_t i = 0; i < t.pixels.rgb.size(); ++i) t.pixels.rgb[i] = base + float(i) / 7;
     t.pixel_samples.assign(static_cast<std::size_t>(tile.width()) * tile.height(), 5);
+    t.spread = Image(tile.width(), tile.height());
+    for (std::size_t i = 0; i < t.spread.rgb.size(); ++i) t.spread.rgb[i] = base * 1e-3f + float(i);
+    t.error_sums.runs = {0.1 + base, 1e-300, 3.5};
+    t.error_sums.runs_pixels = {12, 13, 0};
     t.rays = {11, 22, 33, 44};
     t.samples = 5 * t.pixel_samples.size();
     t.converged = 3;
@@ -77,6 +81,8 @@ TEST(Checkpoint, TilesComeBackWithEveryBitAndCount) {
         EXPECT_EQ(c.tiles[i].tile, tiles[i].tile);
         EXPECT_EQ(c.tiles[i].pixels.rgb, tiles[i].pixels.rgb);
         EXPECT_EQ(c.tiles[i].pixel_samples, tiles[i].pixel_samples);
+        EXPECT_EQ(c.tiles[i].spread.rgb, tiles[i].spread.rgb);
+        EXPECT_EQ(c.tiles[i].error_sums, tiles[i].error_sums);
         EXPECT_EQ(c.tiles[i].rays.total(), 110u);
         EXPECT_EQ(c.tiles[i].rays.refraction, 44u);
         EXPECT_EQ(c.tiles[i].samples, tiles[i].samples);
@@ -260,7 +266,12 @@ TEST_F(CheckpointCli, DamagedTruncatedAndForeignCheckpointsExitTwoAndChangeNothi
     const std::string good = read_bytes(dir_ / "c.ckpt");
     std::string damaged = good;
     damaged[damaged.size() / 2] ^= 0x40;
+    std::string format1 = good;  // written by a drt before the error estimate
+    format1[7] = '1';
     const std::vector<std::pair<std::string, std::string>> cases{
+        {format1,
+         "checkpoint format 1 of another drt version, this one reads format 2: not resumed and "
+         "nothing written (delete it or name another --checkpoint file)"},
         {damaged, "checksum does not match"},
         {good.substr(0, good.size() - 100), "checksum does not match"},
         {good.substr(0, 5), "not a drt checkpoint"},

@@ -177,7 +177,11 @@ TEST(ConvergeCli, PrintsOneRowPerCountAndWritesTheCsv) {
     EXPECT_NE(r.out.find("slope of log RMSE against log samples: -"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("slope of log RMSE against log seconds: "), std::string::npos) << r.out;
     const std::string csv = read_text(dir / "c.csv");
-    ASSERT_EQ(csv.rfind("spp,seconds,rmse,relmse,mean_spp,cpu_seconds,fitted\n2,", 0), 0u) << csv;
+    ASSERT_EQ(csv.rfind("spp,seconds,rmse,relmse,mean_spp,cpu_seconds,fitted,estimated_rmse,"
+                        "estimated_relmse\n2,",
+                        0),
+              0u)
+        << csv;
     EXPECT_NE(csv.find("\n8,"), std::string::npos) << csv;
     EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3) << csv;
 

@@ -134,7 +134,7 @@ if [ "$plots_only" -eq 0 ]; then
             converge "plain-test$t-$s" "$thesis/test$t.xml" --scale $thesis_scale --sampler $s \
                 --spp 16,32,64,128,256,512 --reference "$work/ref-test$t.pfm"
             csv=$work/adaptive-test$t-$s.csv
-            echo "threshold,spp,seconds,rmse,relmse,mean_spp,cpu_seconds,fitted" >"$csv"
+            echo "threshold,spp,seconds,rmse,relmse,mean_spp,cpu_seconds,fitted,estimated_rmse,estimated_relmse" >"$csv"
             for x in 0.02 0.01 0.005 0.0025 0.00125; do
                 log "test$t: $s, adaptive, noise threshold $x"
                 converge "adaptive-test$t-$s-$x" "$thesis/test$t.xml" --scale $thesis_scale \

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "drt/error_estimate.h"
 #include "drt/image.h"
 #include "drt/renderer.h"
 #include "drt/scene.h"
@@ -26,6 +27,8 @@ struct ConvergencePoint {
     // False for 1 spp among larger counts: one sample per pixel takes the pixel's centre instead
     // of sampling its area, a different (deterministic) estimator that the slopes leave out.
     bool fitted = true;
+    // The image's own estimate of rmse and relmse, made without the reference (error_estimate.h).
+    ErrorEstimate estimate;
 };
 
 struct Convergence {
@@ -63,7 +66,8 @@ Convergence measure_convergence(Scene& scene, const std::vector<int>& spps, cons
                                 const RenderOptions& options,
                                 const std::function<void(const ConvergencePoint&)>& on_point = {});
 
-// "spp,seconds,rmse,relmse,mean_spp,cpu_seconds,fitted" and one line per point.
+// "spp,seconds,rmse,relmse,mean_spp,cpu_seconds,fitted,estimated_rmse,estimated_relmse" and one
+// line per point; the estimates are empty where there are none.
 std::string convergence_csv(const Convergence& c);
 
 // Parses a comma-separated list of counts from 1 to kMaxSamples such as "1,4,16"; throws

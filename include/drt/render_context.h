@@ -45,26 +45,32 @@ class RenderContext {
     // The whole image's tiles, row by row; a tile's index is its position here.
     const std::vector<Tile>& tiles() const { return tiles_; }
 
+    // How the sampler's samples tell their error (error_estimate.h).
+    SpreadKind spread_kind() const;
+
     // Renders every pixel of `tile`. Safe to call from several threads at once.
     TileBuffer render_tile(const Tile& tile) const;
 
   private:
-    // What one pixel's render leaves: its value, the camera samples it took, whether adaptive
-    // sampling stopped it early.
+    // What one pixel's render leaves: its value, the spread of its samples, the camera samples it
+    // took, whether adaptive sampling stopped it early.
     struct Pixel {
         Color value;
+        Color spread;
         std::uint32_t samples = 0;
         bool converged = false;
     };
     // Reused from pixel to pixel of a tile: the radiance of each camera sample of the pixel in
-    // hand, and their luminances for the adaptive estimate.
+    // hand, and for adaptive sampling all the pixel's samples so far and their luminances.
     struct Scratch {
         std::vector<Color> colors;
+        std::vector<Color> taken;
         std::vector<double> luminances;
     };
 
-    Pixel plain_pixel(int x, int y, Scratch& scratch, RayCounts& rays) const;
-    Pixel adaptive_pixel(int x, int y, Scratch& scratch, RayCounts& rays) const;
+    // Both add their rays and error sums to `buffer`.
+    Pixel plain_pixel(int x, int y, Scratch& scratch, TileBuffer& buffer) const;
+    Pixel adaptive_pixel(int x, int y, Scratch& scratch, TileBuffer& buffer) const;
 
     const Scene& scene_;
     std::unique_ptr<Sampler> sampler_;

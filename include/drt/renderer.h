@@ -10,6 +10,7 @@
 #include <stop_token>
 #include <vector>
 
+#include "drt/error_estimate.h"
 #include "drt/image.h"
 #include "drt/integrator.h"
 #include "drt/render_context.h"
@@ -38,6 +39,8 @@ struct RenderStats {
     std::uint64_t pixels_converged = 0;  // adaptive: pixels that stopped before the maximum
     // Adaptive sampling as applied, the minimum capped at the maximum; absent for a plain render.
     std::optional<AdaptiveSampling> adaptive;
+    // The image's own estimate of its error against the converged image (error_estimate.h).
+    ErrorEstimate error;
 };
 
 struct RenderResult {
@@ -46,6 +49,9 @@ struct RenderResult {
     RenderStats stats;
     // Adaptive sampling only: the camera samples each pixel took, row by row.
     std::vector<std::uint32_t> pixel_samples;
+    // The spread of each pixel's samples, per channel: times stats.error.scale, the variance of
+    // the pixel's mean.
+    Image spread;
     // Tiles not rendered because a stop was requested (their pixels are 0); empty otherwise.
     std::vector<Tile> unfinished;
 };
@@ -58,8 +64,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options);
 // options.adaptive is ignored: the context's applies.
 RenderResult render(const RenderContext& context, ImageSink& sink, const RenderOptions& options);
 
-// What the tiles in `sink` make: the image, the per-pixel sample counts, the totals and the
-// tiles still missing (stats.seconds and stats.threads are left for the caller).
+// What the tiles in `sink` make: the image, the per-pixel sample counts and spreads, the
+// totals, the error estimate and the tiles still missing (stats.seconds and stats.threads are left
+// for the caller).
 RenderResult assembled(const RenderContext& context, const ImageSink& sink);
 
 // Renders tiles from `source` on options.threads workers (capped at source.size()) into `sink`

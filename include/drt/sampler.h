@@ -77,6 +77,9 @@ class Sampler {
     // count .. 2*count-1 then refine the pattern of the first count instead of repeating it, so
     // a renderer may add samples to a pixel by continuing the index.
     virtual bool progressive() const { return false; }
+    // True when every number is independent of every other: a pixel's samples are then
+    // independent, and their sample variance over n is the variance of their mean.
+    virtual bool independent() const { return false; }
 };
 
 // get_2d for the samples of one run of a pixel (first.index, first.index + 1, ...), remembering
@@ -112,6 +115,7 @@ class RunPoints {
 class IndependentSampler final : public Sampler {
   public:
     std::string_view name() const override { return "random"; }
+    bool independent() const override { return true; }
     double get_1d(const PixelSample& s, std::uint32_t dim) const override;
     Vec2 get_2d(const PixelSample& s, std::uint32_t dim) const override;
     Vec2 get_2d_in_set(const PixelSample& s, std::uint32_t dim, std::uint32_t j,

@@ -12,6 +12,7 @@
 #include <span>
 #include <vector>
 
+#include "drt/error_estimate.h"
 #include "drt/image.h"
 #include "drt/integrator.h"
 
@@ -39,6 +40,8 @@ struct TileBuffer {
     Tile tile;
     Image pixels;                              // the tile's own width × height, row 0 at its top
     std::vector<std::uint32_t> pixel_samples;  // camera samples each pixel took, row by row
+    Image spread;          // of each pixel's samples, per channel (error_estimate.h)
+    ErrorSums error_sums;  // the tile's pixels' shares of the image's error estimate
     RayCounts rays;
     std::uint64_t samples = 0;    // camera samples over the tile's pixels
     std::uint64_t converged = 0;  // adaptive: pixels that stopped before the maximum
@@ -77,7 +80,8 @@ class TileQueue final : public TileSource {
     std::atomic<std::size_t> next_{0};
 };
 
-// Assembles tile buffers into the image, the per-pixel sample counts and the totals, and
+// Assembles tile buffers into the image, the per-pixel sample counts and spreads and the
+// totals, and
 // remembers which tiles it has. A tile given twice is an error: its counts would be summed twice.
 class ImageSink final : public TileSink {
   public:
@@ -93,6 +97,9 @@ class ImageSink final : public TileSink {
     // The assembly so far; read them once no thread is adding any more.
     const Image& image() const { return image_; }
     const std::vector<std::uint32_t>& pixel_samples() const { return pixel_samples_; }
+    const Image& spread() const { return spread_; }
+    // Added up in tile order, so the same whatever order the tiles came in.
+    ErrorSums error_sums() const;
     const RayCounts& rays() const { return rays_; }
     std::uint64_t samples() const { return samples_; }
     std::uint64_t converged() const { return converged_; }
@@ -101,6 +108,8 @@ class ImageSink final : public TileSink {
     std::vector<Tile> grid_;
     Image image_;
     std::vector<std::uint32_t> pixel_samples_;
+    Image spread_;
+    std::vector<ErrorSums> error_sums_;  // by tile index
     RayCounts rays_;
     std::uint64_t samples_ = 0, converged_ = 0;
     std::vector<bool> done_;  // by tile index
