@@ -71,11 +71,7 @@ void add_ball(Scene& scene, const Material& m, int levels, double radius,
 // A ball of radius 1.5 at `offset` on a floor, lit from the side by a point light, seen from
 // z = -10: the ball an analytic sphere or an icosphere of `levels` subdivisions.
 Scene ball_scene(const Material& material, int levels, const Vec3& offset = {}) {
-    Scene scene;
-    scene.path = "test";
-    scene.settings.width = 48;
-    scene.settings.height = 48;
-    scene.settings.samples = 4;
+    Scene scene = testing::blank_scene(48, 48, 4);
     scene.background = {0.2, 0.3, 0.4};
     scene.view = LookAt{offset + Vec3{0, 1, -10}, offset, {0, 1, 0}, 22};
     const Material& m = add_material(scene, material);
@@ -119,11 +115,7 @@ TEST(MeshRender, FarFromTheOriginAnIcosphereRendersLikeTheSphere) {
 // A square floor of two triangles, or the plane it lies in, lit at a grazing angle: any acne
 // (a shadow ray meeting the floor it left) would darken pixels of the mesh's image.
 Scene floor_scene(bool triangles, const Vec3& offset) {
-    Scene scene;
-    scene.path = "test";
-    scene.settings.width = 40;
-    scene.settings.height = 40;
-    scene.settings.samples = 1;
+    Scene scene = testing::blank_scene(40, 40, 1);
     scene.view = LookAt{offset + Vec3{0, 50, 0}, offset, {0, 0, 1}, 60};
     const Material& grey = add_material(scene, testing::grey_lambert());
     if (triangles) {
@@ -164,11 +156,7 @@ TEST(MeshRender, ImagesDoNotDependOnTheThreadCount) {
 
 // A ball of radius 1.5 alone against the background, seen from z = -10.
 Scene lone_ball(const Material& material, int levels) {
-    Scene scene;
-    scene.path = "test";
-    scene.settings.width = 48;
-    scene.settings.height = 48;
-    scene.settings.samples = 1;
+    Scene scene = testing::blank_scene(48, 48, 1);
     scene.background = {1, 1, 1};
     scene.view = LookAt{{0, 0, -10}, {0, 0, 0}, {0, 1, 0}, 20};
     add_ball(scene, add_material(scene, material), levels, 1.5, {Vec3{}});
@@ -306,11 +294,7 @@ TEST(MeshRender, InsideAGlassIcosphereRaysAreTotallyReflectedAsInTheSphere) {
 Scene streak_scene(int levels) {
     constexpr int kWidth = 64, kHeight = 9;
     constexpr double kDepth = 100, kRadius = 3, kPath = 30;
-    Scene scene;
-    scene.path = "test";
-    scene.settings.width = kWidth;
-    scene.settings.height = kHeight;
-    scene.settings.samples = 64;
+    Scene scene = testing::blank_scene(kWidth, kHeight, 64);
     scene.ambient = {1, 1, 1};
     const double fov = 2 * std::atan(kHeight / 2.0 / kDepth) * 180 / kPi;
     scene.view = LookAt{{0, 0, 0}, {0, 0, 1}, {0, 1, 0}, fov};
@@ -422,11 +406,7 @@ TEST(MeshRender, SliverAndDegenerateTrianglesNeverGiveANonFinitePixel) {
 // scene (camera, lights, geometry) scaled by `scale`. Lights in drt do not fall off with
 // distance, so the image should not change with the scale.
 Scene scaled_mesh_scene(double scale) {
-    Scene scene;
-    scene.path = "test";
-    scene.settings.width = 40;
-    scene.settings.height = 30;
-    scene.settings.samples = 4;
+    Scene scene = testing::blank_scene(40, 30, 4);
     scene.settings.shadow_rays = 4;
     scene.background = {0.2, 0.3, 0.4};
     scene.ambient = {0.05, 0.05, 0.05};

@@ -45,6 +45,16 @@ inline Material glass(double index, std::optional<double> sharpness = std::nullo
     return m;
 }
 
+// A scene of `width` x `height` pixels and `samples` samples per pixel, with nothing in it yet.
+inline Scene blank_scene(int width, int height, int samples) {
+    Scene scene;
+    scene.path = "test";
+    scene.settings.width = width;
+    scene.settings.height = height;
+    scene.settings.samples = samples;
+    return scene;
+}
+
 // A camera at height `height` above the floor y = 0, looking straight down.
 inline Scene floor_scene(int width, int height, double eye_height = 50) {
     Scene scene;
