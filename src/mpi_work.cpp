@@ -1,25 +1,21 @@
 #include "drt/mpi_work.h"
 
-#include <stdexcept>
-#include <string>
-#include <string_view>
-
-#ifdef DRT_HAVE_MPI
-#include <mpi.h>
-
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <cstring>
 #include <deque>
 #include <exception>
+#include <filesystem>
 #include <mutex>
 #include <optional>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 #include "drt/checkpoint.h"
-#endif
 
 namespace drt {
 
@@ -30,26 +26,6 @@ bool launched_by_mpirun(const std::function<const char*(const char*)>& getenv) {
     }
     return false;
 }
-
-#ifndef DRT_HAVE_MPI
-
-MpiJob::MpiJob() {
-    throw std::runtime_error(
-        "started by mpirun, but this drt was built without MPI (install libopenmpi-dev and "
-        "rebuild)");
-}
-MpiJob::~MpiJob() = default;
-int MpiJob::leaders(int value) const {
-    return value;
-}
-int MpiJob::highest(int value) const {
-    return value;
-}
-int MpiJob::render(const RenderContext&, std::vector<Tile>, TileSink&, const RenderOptions&) const {
-    throw std::logic_error("MPI render without MPI");
-}
-
-#else
 
 namespace {
 
@@ -67,33 +43,49 @@ enum Tag : int {
 // tile's render time (milliseconds), long enough that polling costs no measurable CPU.
 constexpr auto kIdle = std::chrono::microseconds(200);
 
-void check(int code, const char* what) {
-    if (code != MPI_SUCCESS) throw std::runtime_error(std::string("MPI: ") + what + " failed");
+std::vector<unsigned char> bytes_of(const std::vector<std::uint64_t>& words) {
+    std::vector<unsigned char> bytes(words.size() * sizeof(std::uint64_t));
+    if (!words.empty()) std::memcpy(bytes.data(), words.data(), bytes.size());
+    return bytes;
 }
 
-std::vector<std::uint64_t> indices_of(const std::vector<Tile>& tiles) {
-    std::vector<std::uint64_t> out;
-    out.reserve(tiles.size());
-    for (const Tile& t : tiles) out.push_back(t.index);
-    return out;
+// Tile indices travel as the machine's 64-bit words: every process of a job runs the same
+// binary on the same kind of processor.
+void send_tiles(const Transport& transport, const std::vector<Tile>& tiles, int to, int tag) {
+    std::vector<std::uint64_t> indices;
+    indices.reserve(tiles.size());
+    for (const Tile& t : tiles) indices.push_back(t.index);
+    transport.send(to, tag, bytes_of(indices));
 }
 
-void send_indices(const std::vector<std::uint64_t>& indices, int to, int tag) {
-    check(MPI_Send(indices.data(), static_cast<int>(indices.size()), MPI_UINT64_T, to, tag,
-                   MPI_COMM_WORLD),
-          "send");
+std::vector<Tile> receive_tiles(const Transport& transport, const RenderContext& context, int from,
+                                int tag) {
+    const std::vector<unsigned char> bytes = transport.receive(from, tag);
+    if (bytes.size() % sizeof(std::uint64_t) != 0) {
+        throw std::runtime_error("MPI: a list of tiles of " + std::to_string(bytes.size()) +
+                                 " bytes");
+    }
+    std::vector<Tile> tiles;
+    for (std::size_t at = 0; at < bytes.size(); at += sizeof(std::uint64_t)) {
+        std::uint64_t index = 0;
+        std::memcpy(&index, bytes.data() + at, sizeof index);
+        tiles.push_back(context.tiles().at(static_cast<std::size_t>(index)));
+    }
+    return tiles;
 }
 
-std::vector<std::uint64_t> receive_indices(int from, int tag) {
-    MPI_Status status;
-    check(MPI_Probe(from, tag, MPI_COMM_WORLD, &status), "probe");
-    int count = 0;
-    MPI_Get_count(&status, MPI_UINT64_T, &count);
-    std::vector<std::uint64_t> indices(static_cast<std::size_t>(count));
-    check(
-        MPI_Recv(indices.data(), count, MPI_UINT64_T, from, tag, MPI_COMM_WORLD, MPI_STATUS_IGNORE),
-        "receive");
-    return indices;
+void send_int(const Transport& transport, int value, int to, int tag) {
+    std::vector<unsigned char> bytes(sizeof value);
+    std::memcpy(bytes.data(), &value, sizeof value);
+    transport.send(to, tag, bytes);
+}
+
+int receive_int(const Transport& transport, int from, int tag) {
+    const std::vector<unsigned char> bytes = transport.receive(from, tag);
+    int value = 0;
+    if (bytes.size() != sizeof value) throw std::runtime_error("MPI: a request of the wrong size");
+    std::memcpy(&value, bytes.data(), sizeof value);
+    return value;
 }
 
 // The leader's tiles not handed out yet, shared by its own workers and the processes it serves.
@@ -145,37 +137,27 @@ class LeaderQueue final : public TileSource {
 
 // The leader's communication thread: answers requests, passes finished tiles to the sink and
 // takes back unrendered ones, until every other process has said it is done.
-void serve(const RenderContext& context, LeaderQueue& queue, TileSink& sink, int processes,
-           std::exception_ptr& error) {
+void serve(const Transport& transport, const RenderContext& context, LeaderQueue& queue,
+           TileSink& sink, std::exception_ptr& error) {
+    const int processes = transport.size();
     int active = processes - 1;
-    std::vector<unsigned char> bytes;
     while (active > 0) {
-        int flag = 0;
-        MPI_Status status;
-        check(MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, &status), "probe");
-        if (!flag) {
+        const std::optional<Envelope> waiting = transport.poll(Transport::kAny, Transport::kAny);
+        if (!waiting) {
             std::this_thread::sleep_for(kIdle);
             continue;
         }
-        const int from = status.MPI_SOURCE;
-        switch (status.MPI_TAG) {
+        const int from = waiting->from;
+        switch (waiting->tag) {
             case kRequest: {
-                int wanted = 0;
-                check(MPI_Recv(&wanted, 1, MPI_INT, from, kRequest, MPI_COMM_WORLD,
-                               MPI_STATUS_IGNORE),
-                      "receive");
-                send_indices(indices_of(queue.take(static_cast<std::size_t>(std::max(1, wanted)),
-                                                   processes)),
-                             from, kGrant);
+                const int wanted = receive_int(transport, from, kRequest);
+                send_tiles(transport,
+                           queue.take(static_cast<std::size_t>(std::max(1, wanted)), processes),
+                           from, kGrant);
                 break;
             }
             case kResult: {
-                int count = 0;
-                MPI_Get_count(&status, MPI_BYTE, &count);
-                bytes.resize(static_cast<std::size_t>(count));
-                check(MPI_Recv(bytes.data(), count, MPI_BYTE, from, kResult, MPI_COMM_WORLD,
-                               MPI_STATUS_IGNORE),
-                      "receive");
+                const std::vector<unsigned char> bytes = transport.receive(from, kResult);
                 if (error) break;  // drain the others, but add nothing more
                 try {
                     sink.add(
@@ -186,18 +168,13 @@ void serve(const RenderContext& context, LeaderQueue& queue, TileSink& sink, int
                 }
                 break;
             }
-            case kDone: {
-                std::vector<Tile> back;
-                for (std::uint64_t i : receive_indices(from, kDone)) {
-                    back.push_back(context.tiles().at(static_cast<std::size_t>(i)));
-                }
-                queue.give_back(back);
+            case kDone:
+                queue.give_back(receive_tiles(transport, context, from, kDone));
                 --active;
                 break;
-            }
             default:
                 throw std::logic_error("MPI: unexpected message tag " +
-                                       std::to_string(status.MPI_TAG));
+                                       std::to_string(waiting->tag));
         }
     }
 }
@@ -272,48 +249,40 @@ class Outbox final : public TileSink {
 
 // Another process's communication thread: keeps `threads` tiles ahead of its workers, sends
 // their results, and once the workers have finished gives back what they did not take.
-void work_for_leader(const RenderContext& context, WorkerQueue& queue, Outbox& outbox, int threads,
-                     const std::atomic<bool>& workers_finished, const std::stop_token& stop) {
+void work_for_leader(const Transport& transport, const RenderContext& context, WorkerQueue& queue,
+                     Outbox& outbox, int threads, const std::atomic<bool>& workers_finished,
+                     const std::stop_token& stop) {
     bool requested = false, dry = false;
     const auto receive_grant = [&] {
-        std::vector<Tile> tiles;
-        for (std::uint64_t i : receive_indices(0, kGrant)) {
-            tiles.push_back(context.tiles().at(static_cast<std::size_t>(i)));
-        }
+        std::vector<Tile> tiles = receive_tiles(transport, context, 0, kGrant);
         requested = false;
         dry = tiles.empty();
         queue.add(tiles);
+    };
+    const auto send_results = [&] {
+        bool sent = false;
+        while (std::optional<std::vector<unsigned char> > m = outbox.take()) {
+            transport.send(0, kResult, *m);
+            sent = true;
+        }
+        return sent;
     };
     for (;;) {
         bool busy = false;
         if (!requested && !dry && !stop.stop_requested() &&
             queue.queued() < static_cast<std::size_t>(threads)) {
-            const int wanted = threads;
-            check(MPI_Send(&wanted, 1, MPI_INT, 0, kRequest, MPI_COMM_WORLD), "send");
+            send_int(transport, threads, 0, kRequest);
             requested = true;
         }
-        if (requested) {
-            int flag = 0;
-            check(MPI_Iprobe(0, kGrant, MPI_COMM_WORLD, &flag, MPI_STATUS_IGNORE), "probe");
-            if (flag) {
-                receive_grant();
-                busy = true;
-            }
-        }
-        while (std::optional<std::vector<unsigned char> > m = outbox.take()) {
-            check(MPI_Send(m->data(), static_cast<int>(m->size()), MPI_BYTE, 0, kResult,
-                           MPI_COMM_WORLD),
-                  "send");
+        if (requested && transport.poll(0, kGrant)) {
+            receive_grant();
             busy = true;
         }
+        busy = send_results() || busy;
         if (workers_finished.load()) {
             if (requested) receive_grant();  // answered in any case: take it to give it back
-            while (std::optional<std::vector<unsigned char> > m = outbox.take()) {
-                check(MPI_Send(m->data(), static_cast<int>(m->size()), MPI_BYTE, 0, kResult,
-                               MPI_COMM_WORLD),
-                      "send");
-            }
-            send_indices(indices_of(queue.drain()), 0, kDone);
+            send_results();
+            send_tiles(transport, queue.drain(), 0, kDone);
             return;
         }
         if (!busy) std::this_thread::sleep_for(kIdle);
@@ -323,32 +292,26 @@ void work_for_leader(const RenderContext& context, WorkerQueue& queue, Outbox& o
 }  // namespace
 
 MpiJob::MpiJob() {
-    // Only the communication thread calls MPI while workers render, and only the main thread
-    // otherwise: one thread at a time.
-    int provided = 0;
-    check(MPI_Init_thread(nullptr, nullptr, MPI_THREAD_SERIALIZED, &provided), "start");
-    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
-    MPI_Comm_size(MPI_COMM_WORLD, &size_);
-    MPI_Comm node;
-    check(MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node),
-          "split by machine");
-    MPI_Comm_size(node, &local_size_);
-    MPI_Comm_free(&node);
+    const std::filesystem::path file = mpi_module_path();
+    try {
+        module_ = std::make_unique<SharedModule>(file);
+    } catch (const std::runtime_error& e) {
+        throw std::runtime_error(
+            std::string("started by mpirun, but the MPI module is missing or broken (") + e.what() +
+            "): build drt where MPI is installed (libopenmpi-dev, tools/install-deps.sh) and "
+            "keep drt_mpi.so beside the drt binary");
+    }
+    transport_ = start_mpi(*module_);
 }
 
-MpiJob::~MpiJob() {
-    MPI_Finalize();
-}
+MpiJob::~MpiJob() = default;
 
 int MpiJob::leaders(int value) const {
-    check(MPI_Bcast(&value, 1, MPI_INT, 0, MPI_COMM_WORLD), "broadcast");
-    return value;
+    return transport_->leaders(value);
 }
 
 int MpiJob::highest(int value) const {
-    int out = value;
-    check(MPI_Allreduce(&value, &out, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD), "reduce");
-    return out;
+    return transport_->highest(value);
 }
 
 int MpiJob::render(const RenderContext& context, std::vector<Tile> todo, TileSink& sink,
@@ -357,12 +320,12 @@ int MpiJob::render(const RenderContext& context, std::vector<Tile> todo, TileSin
     if (run.threads <= 0) {
         // The machine's cores are shared by the processes this job put on it.
         run.threads = std::max(
-            1, static_cast<int>(std::thread::hardware_concurrency()) / std::max(1, local_size_));
+            1, static_cast<int>(std::thread::hardware_concurrency()) / std::max(1, local_size()));
     }
     if (leader()) {
         LeaderQueue queue(std::move(todo), options.stop);
         std::exception_ptr served_error;
-        std::jthread server([&] { serve(context, queue, sink, size_, served_error); });
+        std::jthread server([&] { serve(*transport_, context, queue, sink, served_error); });
         int threads = 0;
         std::exception_ptr error;
         try {
@@ -386,7 +349,8 @@ int MpiJob::render(const RenderContext& context, std::vector<Tile> todo, TileSin
     Outbox outbox;
     std::atomic<bool> workers_finished{false};
     std::jthread communicator([&] {
-        work_for_leader(context, queue, outbox, run.threads, workers_finished, options.stop);
+        work_for_leader(*transport_, context, queue, outbox, run.threads, workers_finished,
+                        options.stop);
     });
     int threads = 0;
     std::exception_ptr error;
@@ -400,7 +364,5 @@ int MpiJob::render(const RenderContext& context, std::vector<Tile> todo, TileSin
     if (error) std::rethrow_exception(error);
     return threads;
 }
-
-#endif
 
 }  // namespace drt

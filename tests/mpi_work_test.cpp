@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "run_drt.h"
+#include "temp_folder.h"
 
 namespace drt {
 namespace {
@@ -44,6 +45,38 @@ const fs::path kSource = DRT_SOURCE_DIR;
 const std::string kMotion = (kSource / "scenes/thesis/test5.xml").string();
 // Glossy reflection and refraction, depth of field, soft shadows.
 const std::string kGlossy = (kSource / "scenes/thesis/test6.xml").string();
+
+using MpiModule = TempFolderTest;
+
+TEST_F(MpiModule, APlainRunLoadsNoMpiLibrary) {
+    // The dynamic loader lists every library it loads; a drt linked with MPI would list libmpi.
+    const Outcome r = run_process({"env", "LD_DEBUG=libs", DRT_BINARY, "info", kGlossy}, dir_);
+    ASSERT_EQ(r.status, 0) << r.err;
+    ASSERT_NE(r.err.find("find library=libstdc++"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("libmpi"), std::string::npos) << r.err;
+}
+
+TEST_F(MpiModule, UnderALauncherWithoutItDrtSaysWhatIsMissingAndExits2) {
+    const fs::path alone = dir_ / "drt";
+    fs::copy_file(DRT_BINARY, alone);
+    const std::vector<std::string> argv{"env", "OMPI_COMM_WORLD_SIZE=1", alone.string(), "info",
+                                        kGlossy};
+    Outcome r = run_process(argv, dir_);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.out, "");
+    const std::string missing =
+        "drt: started by mpirun, but the MPI module is missing or broken (" +
+        (dir_ / "drt_mpi.so").string() + ": cannot open shared object file";
+    EXPECT_EQ(r.err.find(missing), 0u) << r.err;
+    EXPECT_NE(r.err.find("keep drt_mpi.so beside the drt binary"), std::string::npos) << r.err;
+    write_bytes(dir_ / "drt_mpi.so", "not a shared object");
+    r = run_process(argv, dir_);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.err.find("drt: started by mpirun, but the MPI module is missing or broken (" +
+                         (dir_ / "drt_mpi.so").string() + ": "),
+              0u)
+        << r.err;
+}
 
 bool have_mpirun() {
     std::istringstream path(std::getenv("PATH") ? std::getenv("PATH") : "");

@@ -7,11 +7,13 @@
 
 #include <cstdlib>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "drt/render_context.h"
 #include "drt/renderer.h"
 #include "drt/tile.h"
+#include "drt/transport.h"
 
 namespace drt {
 
@@ -24,17 +26,18 @@ bool launched_by_mpirun(const std::function<const char*(const char*)>& getenv = 
 // MPI, started for the life of this object; constructed only when launched_by_mpirun().
 class MpiJob {
   public:
-    // Throws std::runtime_error when this drt was built without MPI.
+    // Loads drt_mpi.so from beside the running binary and starts MPI. Throws
+    // std::runtime_error, saying what to do, when the module is missing or MPI cannot start.
     MpiJob();
     ~MpiJob();
     MpiJob(const MpiJob&) = delete;
     MpiJob& operator=(const MpiJob&) = delete;
 
-    int rank() const { return rank_; }
-    int size() const { return size_; }
-    bool leader() const { return rank_ == 0; }
+    int rank() const { return transport_->rank(); }
+    int size() const { return transport_->size(); }
+    bool leader() const { return rank() == 0; }
     // Processes of this job on this machine, this one included: they share its cores.
-    int local_size() const { return local_size_; }
+    int local_size() const { return transport_->local_size(); }
 
     // The leader's value, on every process (collective).
     int leaders(int value) const;
@@ -50,7 +53,9 @@ class MpiJob {
                const RenderOptions& options) const;
 
   private:
-    int rank_ = 0, size_ = 1, local_size_ = 1;
+    // Declared first, so destroyed last: the transport's code lives in the module.
+    std::unique_ptr<SharedModule> module_;
+    std::unique_ptr<Transport> transport_;
 };
 
 }  // namespace drt
