@@ -9,6 +9,7 @@
 
 #include "drt/atomic_file.h"
 #include "drt/rng.h"
+#include "drt/text.h"
 
 namespace drt {
 
@@ -19,10 +20,13 @@ namespace {
 using Bytes = std::vector<unsigned char>;
 
 // "DRTCKPT" and a format number: a reader refuses a format it does not know instead of guessing.
-// Format 2 added each pixel's spread and each tile's error sums (error_estimate.h).
-constexpr char kMagic[8] = {'D', 'R', 'T', 'C', 'K', 'P', 'T', '2'};
+// Format 2 added each pixel's spread and each tile's error sums (error_estimate.h); format 3
+// fingerprints each file the scene reads on its own (format 2 had one hash for them all).
+constexpr char kMagic[8] = {'D', 'R', 'T', 'C', 'K', 'P', 'T', '3'};
 // The longest version string a reader accepts, so a damaged length cannot ask for gigabytes.
 constexpr std::uint32_t kMaxVersionLength = 256;
+// Likewise for a file's name (PATH_MAX on Linux).
+constexpr std::uint32_t kMaxNameLength = 4096;
 
 [[noreturn]] void fail(const fs::path& file, const std::string& what) {
     throw CheckpointError(file.string() + ": " + what);
@@ -138,6 +142,25 @@ Bytes read_all(const fs::path& file) {
     return data;
 }
 
+// What differs between the files a checkpoint's render read (`got`) and this render's.
+std::string files_differing(const std::vector<FileFingerprint>& got,
+                            const std::vector<FileFingerprint>& expected) {
+    if (got.empty() || expected.empty() || !(got[0] == expected[0])) {
+        return "another scene file (its contents differ)";
+    }
+    if (got.size() != expected.size()) {
+        return "a scene reading another number of files (" + std::to_string(got.size() - 1) +
+               ", not " + std::to_string(expected.size() - 1) + ")";
+    }
+    for (std::size_t i = 1; i < got.size(); ++i) {
+        if (!(got[i] == expected[i])) {
+            return "another version of " + printable(expected[i].name) +
+                   " (a file the scene reads: its contents differ)";
+        }
+    }
+    return "other files";
+}
+
 // Doubles by their bits, so that two settings that print alike but differ still differ.
 std::string exact(double v) {
     return std::to_string(std::bit_cast<std::uint64_t>(v));
@@ -163,10 +186,9 @@ RenderIdentity identify_render(std::span<const fs::path> files, const RenderSett
                                std::uint64_t tiles) {
     RenderIdentity id;
     id.version = DRT_VERSION;
-    id.scene = hash_of(files.size());
     for (const fs::path& f : files) {
         try {
-            id.scene = hash_combine(id.scene, hash_bytes(read_all(f)));
+            id.files.push_back({f.string(), hash_bytes(read_all(f))});
         } catch (const CheckpointError& e) {
             throw CheckpointError(std::string(e.what()) + " (needed for the checkpoint)");
         }
@@ -194,7 +216,11 @@ std::vector<unsigned char> encode_checkpoint(const RenderIdentity& id,
     Writer w;
     w.bytes.insert(w.bytes.end(), std::begin(kMagic), std::end(kMagic));
     w.text(id.version);
-    w.u64(id.scene);
+    w.u64(id.files.size());
+    for (const FileFingerprint& f : id.files) {
+        w.text(f.name);
+        w.u64(f.hash);
+    }
     w.u64(id.options);
     w.u32(static_cast<std::uint32_t>(id.width));
     w.u32(static_cast<std::uint32_t>(id.height));
@@ -227,7 +253,13 @@ Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<con
     Checkpoint c;
     RenderIdentity& id = c.identity;
     id.version = r.text(kMaxVersionLength);
-    id.scene = r.u64();
+    const std::uint64_t files = r.u64();
+    // Each takes at least 12 bytes, so a damaged count soon runs out of file.
+    for (std::uint64_t i = 0; i < files; ++i) {
+        FileFingerprint& f = id.files.emplace_back();
+        f.name = r.text(kMaxNameLength);
+        f.hash = r.u64();
+    }
     id.options = r.u64();
     id.width = static_cast<int>(r.u32());
     id.height = static_cast<int>(r.u32());
@@ -253,8 +285,8 @@ std::optional<Checkpoint> read_checkpoint(const fs::path& file, const RenderIden
     std::string differs;
     if (got.version != expected.version) {
         differs = "drt " + got.version + ", not drt " + expected.version;
-    } else if (got.scene != expected.scene) {
-        differs = "another scene file (its contents differ)";
+    } else if (got.files != expected.files) {
+        differs = files_differing(got.files, expected.files);
     } else if (got.width != expected.width || got.height != expected.height) {
         differs = "another image size (" + std::to_string(got.width) + "x" +
                   std::to_string(got.height) + ")";

@@ -490,6 +490,8 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
     options.adaptive = job.adaptive.settings();
     options.checkpoint = checkpoint;
     options.scene_files = {scene_path};
+    options.scene_files.insert(options.scene_files.end(), loaded->files_read.begin(),
+                               loaded->files_read.end());
     options.checkpoint_interval = std::chrono::duration<double>(job.checkpoint_seconds);
     options.stop_after_tiles = job.stop_after_tiles;
     options.stop = job.stop;

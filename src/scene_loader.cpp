@@ -344,7 +344,7 @@ class SceneReader {
         scene_.path = context_.file();
         read_scene(root);
         resolve_objects();
-        return {std::move(scene_), context_.take_warnings()};
+        return {std::move(scene_), context_.take_warnings(), std::move(files_read_)};
     }
 
   private:
@@ -740,6 +740,7 @@ class SceneReader {
         ObjMesh obj;
         try {
             obj = read_obj(obj_path);
+            files_read_.push_back(obj_path);
         } catch (const ObjOpenError& error) {
             in.fail("cannot open " + obj_path.string() + ": " + error.what());
         } catch (const ObjError& error) {
@@ -789,6 +790,7 @@ class SceneReader {
     std::map<std::string, int, std::less<>> setting_lines_;
     std::map<std::string, int, std::less<>> material_lines_;
     std::vector<PendingObject> pending_;
+    std::vector<std::filesystem::path> files_read_;
 };
 
 std::string read_file(const std::filesystem::path& path) {

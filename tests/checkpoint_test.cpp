@@ -67,7 +67,8 @@ TileBuffer some_tile(const Tile& tile, float base) {
 }
 
 RenderIdentity identity_of(const std::vector<Tile>& grid) {
-    return {"9.9.9", 0x1234, 0x5678, 40, 28, grid.size()};
+    return {"9.9.9",    {{"scene.xml", 0x1234}, {"models/mesh.obj", 0x9abc}}, 0x5678, 40, 28,
+            grid.size()};
 }
 
 TEST(Checkpoint, TilesComeBackWithEveryBitAndCount) {
@@ -132,10 +133,19 @@ TEST(Checkpoint, IdentityCoversTheSceneBytesAndEverySettingButNotHowTheWorkIsDon
     EXPECT_TRUE(differs([](RenderSettings& s, auto&) { s.sampler = "sobol"; }));
     EXPECT_TRUE(differs([](RenderSettings& s, auto&) { s.pixel_plane_unit *= 1 + 1e-15; }));
     EXPECT_TRUE(differs([](auto&, auto& a) { a = AdaptiveSampling{0.01, 16}; }));
-    EXPECT_NE(identify_render(std::vector<fs::path>{kSource / "scenes/thesis/test6.xml"},
-                              scene.settings, std::nullopt, 12)
-                  .scene,
-              base.scene);
+    const fs::path other = kSource / "scenes/thesis/test6.xml";
+    EXPECT_NE(identify_render(std::vector{other}, scene.settings, std::nullopt, 12).files,
+              base.files);
+    // Every file the scene reads, on its own and by its bytes alone.
+    const RenderIdentity two =
+        identify_render(std::vector{kEffects, other}, scene.settings, std::nullopt, 12);
+    ASSERT_EQ(two.files.size(), 2u);
+    EXPECT_EQ(two.files[0], base.files[0]);
+    EXPECT_EQ(two.files[1].name, other.string());
+    EXPECT_NE(two.files[1].hash, two.files[0].hash);
+    const std::string bytes = read_bytes(other);
+    EXPECT_EQ(two.files[1].hash,
+              hash_bytes({reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()}));
 }
 
 TEST_F(TempDir, ACheckpointOfAnotherRenderIsRefusedSayingWhatDiffers) {
@@ -157,8 +167,25 @@ TEST_F(TempDir, ACheckpointOfAnotherRenderIsRefusedSayingWhatDiffers) {
     other.version = "9.9.10";
     EXPECT_NE(message(other).find("made by drt 9.9.9, not drt 9.9.10"), std::string::npos);
     other = id;
-    other.scene += 1;
-    EXPECT_NE(message(other).find("another scene file"), std::string::npos);
+    other.files[0].hash += 1;
+    EXPECT_NE(message(other).find("made by another scene file (its contents differ)"),
+              std::string::npos);
+    other = id;
+    other.files[1] = {"meshes/mesh.obj", other.files[1].hash + 1};
+    EXPECT_EQ(message(other), file.string() +
+                                  ": checkpoint of another render: made by another version of "
+                                  "meshes/mesh.obj (a file the scene reads: its contents differ); "
+                                  "not resumed and nothing written (delete it or name another "
+                                  "--checkpoint file)");
+    other = id;
+    other.files.pop_back();
+    EXPECT_NE(message(other).find("made by a scene reading another number of files (1, not 0)"),
+              std::string::npos);
+    // The same bytes reached by other names (from another folder): the same render.
+    other = id;
+    other.files[0].name = "../elsewhere/scene.xml";
+    other.files[1].name = "../elsewhere/models/mesh.obj";
+    EXPECT_EQ(message(other), "accepted");
     other = id;
     other.options += 1;
     EXPECT_EQ(message(other),
@@ -266,11 +293,11 @@ TEST_F(CheckpointCli, DamagedTruncatedAndForeignCheckpointsExitTwoAndChangeNothi
     const std::string good = read_bytes(dir_ / "c.ckpt");
     std::string damaged = good;
     damaged[damaged.size() / 2] ^= 0x40;
-    std::string format1 = good;  // written by a drt before the error estimate
-    format1[7] = '1';
+    std::string format2 = good;  // written by a drt before each file had its own fingerprint
+    format2[7] = '2';
     const std::vector<std::pair<std::string, std::string>> cases{
-        {format1,
-         "checkpoint format 1 of another drt version, this one reads format 2: not resumed and "
+        {format2,
+         "checkpoint format 2 of another drt version, this one reads format 3: not resumed and "
          "nothing written (delete it or name another --checkpoint file)"},
         {damaged, "checksum does not match"},
         {good.substr(0, good.size() - 100), "checksum does not match"},
@@ -297,6 +324,33 @@ TEST_F(CheckpointCli, DamagedTruncatedAndForeignCheckpointsExitTwoAndChangeNothi
     EXPECT_NE(r.err.find("made by another scene file"), std::string::npos) << r.err;
     EXPECT_EQ(read_bytes(dir_ / "c.ckpt"), good);
     EXPECT_FALSE(fs::exists(dir_ / "out.pfm"));
+}
+
+TEST_F(CheckpointCli, AnEditedMeshFileIsRefusedNamingItAndTheOriginalResumes) {
+    write_bytes(dir_ / "scene.xml",
+                "<Scene><Image Width=\"48\" Height=\"32\"/><Materials><Gray/></Materials>"
+                "<Mesh File=\"models/tri.obj\" Material=\"Gray\"/></Scene>");
+    fs::create_directories(dir_ / "models");
+    const std::string obj = "v -5 -5 20\nv 5 -5 20\nv 0 5 20\nf 1 2 3\n";
+    write_bytes(dir_ / "models/tri.obj", obj);
+    const std::vector<std::string> args{"scene.xml", "-o", "out.pfm", "--checkpoint", "c.ckpt"};
+    std::vector<std::string> stopped = args;
+    stopped.insert(stopped.end(), {"--stop-after-tiles", "1"});
+    ASSERT_EQ(run(stopped).status, 130);
+    const std::string kept = read_bytes(dir_ / "c.ckpt");
+    write_bytes(dir_ / "models/tri.obj", "v -5 -5 20\nv 5 -5 20\nv 0 6 20\nf 1 2 3\n");
+    Outcome r = run(args);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.err, "drt: c.ckpt: checkpoint of another render: made by another version of " +
+                         (fs::path("models") / "tri.obj").string() +
+                         " (a file the scene reads: its contents differ); not resumed and "
+                         "nothing written (delete it or name another --checkpoint file)\n");
+    EXPECT_EQ(read_bytes(dir_ / "c.ckpt"), kept);
+    EXPECT_FALSE(fs::exists(dir_ / "out.pfm"));
+    write_bytes(dir_ / "models/tri.obj", obj);
+    r = run(args);
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("tiles resumed"), std::string::npos) << r.err;
 }
 
 // Waits until `file` is written anew (the render is under way), up to a minute.

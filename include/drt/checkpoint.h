@@ -26,10 +26,22 @@ class CheckpointError : public std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
+// One file a render reads: its name as the run that read it gave it, for messages, and a hash of
+// its bytes. Only the bytes count: the same files reached from another folder are the same render.
+struct FileFingerprint {
+    std::string name;
+    std::uint64_t hash = 0;
+
+    friend bool operator==(const FileFingerprint& a, const FileFingerprint& b) {
+        return a.hash == b.hash;
+    }
+};
+
 // What a render's pixels depend on. A checkpoint resumes only a render with the same identity.
 struct RenderIdentity {
-    std::string version;        // drt's
-    std::uint64_t scene = 0;    // hash of the bytes of the scene file and every file it reads
+    std::string version;  // drt's
+    // The scene file, then every file it reads (its meshes' OBJ files), in the order read.
+    std::vector<FileFingerprint> files;
     std::uint64_t options = 0;  // hash of every setting that shapes the image, the seed included
     int width = 0, height = 0;
     std::uint64_t tiles = 0;  // how many tiles the image is cut into

@@ -22,6 +22,9 @@ struct LoadedScene {
     // "FILE:LINE: warning: ..." for every unknown element or attribute, naming the nearest known
     // one.
     std::vector<std::string> warnings;
+    // Every file the scene file made the loader read (the OBJ files of its meshes), in the order
+    // read: with the scene file, what a checkpoint's fingerprint covers (checkpoint.h).
+    std::vector<std::filesystem::path> files_read;
 };
 
 LoadedScene load_scene(const std::filesystem::path& path);
