@@ -233,14 +233,16 @@ std::uint32_t Bvh::build(std::vector<Build>& items, std::uint32_t begin, std::ui
 }
 
 // Still spheres, the common case, inline; a moving sphere's segment and meshes out of line.
+template <bool kAnyHit>
 inline std::optional<double> Bvh::hit(const Primitive& p, const Ray& ray, double origin_scale,
                                       Interval range, std::uint32_t& triangle, Vec2& uv) const {
     if (p.kind == Kind::kStillSphere) {
         return intersect_sphere(p.centre, p.radius, ray, origin_scale, range);
     }
-    return hit_segment(p, ray, origin_scale, range, triangle, uv);
+    return hit_segment<kAnyHit>(p, ray, origin_scale, range, triangle, uv);
 }
 
+template <bool kAnyHit>
 std::optional<double> Bvh::hit_segment(const Primitive& p, const Ray& ray, double origin_scale,
                                        Interval range, std::uint32_t& triangle, Vec2& uv) const {
     if (!p.time.contains(ray.time)) return std::nullopt;
@@ -249,11 +251,18 @@ std::optional<double> Bvh::hit_segment(const Primitive& p, const Ray& ray, doubl
                                 range);
     }
     const Vec3 origin = p.kind == Kind::kStillMesh ? p.centre : motions_[p.motion].at(ray.time);
-    const auto hit = meshes_[p.index].mesh->intersect(ray_in_mesh(ray, origin), range);
-    if (!hit) return std::nullopt;
-    triangle = hit->triangle;
-    uv = {hit->b.b1, hit->b.b2};
-    return hit->t;
+    const TriangleMesh& mesh = *meshes_[p.index].mesh;
+    if constexpr (kAnyHit) {
+        // A shadow ray needs no nearest hit: the mesh's first hit found ends its traversal.
+        if (!mesh.occluded(ray_in_mesh(ray, origin), range)) return std::nullopt;
+        return range.max;
+    } else {
+        const auto hit = mesh.intersect(ray_in_mesh(ray, origin), range);
+        if (!hit) return std::nullopt;
+        triangle = hit->triangle;
+        uv = {hit->b.b1, hit->b.b2};
+        return hit->t;
+    }
 }
 
 template <bool kAnyHit>
@@ -278,7 +287,7 @@ bool Bvh::traverse(const Ray& ray, Interval& range, std::uint64_t planes, Neares
     auto leaf = [&](const Node& node) {
         for (std::uint32_t i = node.offset; i < node.offset + node.count; ++i) {
             const Primitive& p = primitives_[i];
-            if (auto t = hit(p, ray, origin_scale, range, triangle, uv)) {
+            if (auto t = hit<kAnyHit>(p, ray, origin_scale, range, triangle, uv)) {
                 if constexpr (kAnyHit) return true;
                 found = true, nearest = {p.object, is_mesh(p.kind) ? triangle : p.index, uv};
                 range.max = *t;
@@ -359,7 +368,7 @@ bool Bvh::occluded_by(const Ray& ray, Interval range, std::uint64_t planes,
     std::uint32_t triangle = 0;
     Vec2 uv;
     for (const std::uint32_t i : primitives) {
-        if (hit(primitives_[i], ray, origin_scale, range, triangle, uv)) return true;
+        if (hit<true>(primitives_[i], ray, origin_scale, range, triangle, uv)) return true;
     }
     return false;
 }

@@ -6,6 +6,7 @@
 #include <numeric>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <unordered_map>
 
 namespace drt {
@@ -80,6 +81,9 @@ constexpr int kBins = 16;
 // nodes, which the traversal's stack holds.
 constexpr int kSahDepth = 40;
 constexpr int kStackSize = 128;
+// Subtrees of fewer triangles are built on the thread that reached them: a thread costs about
+// what building a few thousand triangles does.
+constexpr std::uint32_t kParallelBuild = 16384;
 
 }  // namespace
 
@@ -100,7 +104,8 @@ struct TriangleMesh::BuildItem {
     float centre(int axis) const { return (lo[axis] + hi[axis]) * 0.5f; }
 };
 
-TriangleMesh::TriangleMesh(const ObjMesh& obj, const MeshTransform& transform, bool smooth) {
+TriangleMesh::TriangleMesh(const ObjMesh& obj, const MeshTransform& transform, bool smooth,
+                           int build_threads) {
     std::vector<Vec3> placed(obj.positions.size());
     Bounds box;
     for (std::size_t i = 0; i < placed.size(); ++i) {
@@ -187,7 +192,9 @@ TriangleMesh::TriangleMesh(const ObjMesh& obj, const MeshTransform& transform, b
                            static_cast<float>(n.z)};
         }
     }
-    build_hierarchy();
+    build_hierarchy(build_threads > 0
+                        ? build_threads
+                        : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
 }
 
 Vec3 TriangleMesh::position(std::uint32_t vertex) const {
@@ -243,7 +250,7 @@ std::size_t TriangleMesh::bytes() const {
            sizeof(*this);
 }
 
-void TriangleMesh::build_hierarchy() {
+void TriangleMesh::build_hierarchy(int threads) {
     if (triangles_.empty()) return;
     std::vector<BuildItem> items(triangles_.size());
     for (std::uint32_t i = 0; i < items.size(); ++i) {
@@ -260,7 +267,10 @@ void TriangleMesh::build_hierarchy() {
     }
     // At most 2n - 1 nodes; a leaf holds two triangles or more unless it is alone.
     nodes_.reserve(items.size());
-    build(items, 0, static_cast<std::uint32_t>(items.size()), 0);
+    // More tasks than threads, so that the unequal halves SAH splits make still keep every
+    // thread busy to the end.
+    build(items, 0, static_cast<std::uint32_t>(items.size()), 0, nodes_,
+          threads > 1 ? 4 * threads : 1);
     nodes_.shrink_to_fit();
     std::vector<std::array<std::uint32_t, 3>> ordered(triangles_.size());
     for (std::size_t i = 0; i < items.size(); ++i) ordered[i] = triangles_[items[i].triangle];
@@ -268,9 +278,10 @@ void TriangleMesh::build_hierarchy() {
 }
 
 std::uint32_t TriangleMesh::build(std::vector<BuildItem>& items, std::uint32_t begin,
-                                  std::uint32_t end, int depth) {
-    const auto index = static_cast<std::uint32_t>(nodes_.size());
-    nodes_.push_back({});
+                                  std::uint32_t end, int depth, std::vector<Node>& nodes,
+                                  int tasks) {
+    const auto index = static_cast<std::uint32_t>(nodes.size());
+    nodes.push_back({});
     Float3 lo = items[begin].lo, hi = items[begin].hi;
     Float3 centre_lo{}, centre_hi{};
     for (int a = 0; a < 3; ++a) centre_lo[a] = centre_hi[a] = items[begin].centre(a);
@@ -282,12 +293,12 @@ std::uint32_t TriangleMesh::build(std::vector<BuildItem>& items, std::uint32_t b
             centre_hi[a] = std::max(centre_hi[a], items[i].centre(a));
         }
     }
-    nodes_[index].lo = lo;
-    nodes_[index].hi = hi;
+    nodes[index].lo = lo;
+    nodes[index].hi = hi;
     const std::uint32_t count = end - begin;
     const auto make_leaf = [&] {
-        nodes_[index].offset = begin;
-        nodes_[index].count = count;
+        nodes[index].offset = begin;
+        nodes[index].count = count;
         return index;
     };
     if (count <= 2) return make_leaf();
@@ -353,15 +364,35 @@ std::uint32_t TriangleMesh::build(std::vector<BuildItem>& items, std::uint32_t b
                              return a.centre(axis) < b.centre(axis);
                          });
     }
-    build(items, begin, mid, depth + 1);
-    const std::uint32_t second = build(items, mid, end, depth + 1);
-    nodes_[index].offset = second;
-    nodes_[index].count = 0;
+    std::uint32_t second = 0;
+    if (tasks > 1 && count >= kParallelBuild) {
+        // The second subtree on a thread of its own, into nodes of its own, then appended after
+        // the first: where the sequential build would have put it, node for node.
+        std::vector<Node> second_nodes;
+        {
+            const std::jthread worker([&] {
+                second_nodes.reserve(end - mid);
+                build(items, mid, end, depth + 1, second_nodes, tasks / 2);
+            });
+            build(items, begin, mid, depth + 1, nodes, tasks - tasks / 2);
+        }
+        second = static_cast<std::uint32_t>(nodes.size());
+        for (Node n : second_nodes) {
+            if (n.count == 0) n.offset += second;
+            nodes.push_back(n);
+        }
+    } else {
+        build(items, begin, mid, depth + 1, nodes, 1);
+        second = build(items, mid, end, depth + 1, nodes, 1);
+    }
+    nodes[index].offset = second;
+    nodes[index].count = 0;
     return index;
 }
 
 template <bool kAnyHit>
-std::optional<MeshHit> TriangleMesh::traverse(const Ray& ray, Interval range) const {
+std::optional<MeshHit> TriangleMesh::traverse(const Ray& ray, Interval range,
+                                              std::uint64_t* tests) const {
     if (nodes_.empty()) return std::nullopt;
     const ShearedRay sheared(ray);
     const BoxRay box_ray{ray.origin, {1 / ray.dir.x, 1 / ray.dir.y, 1 / ray.dir.z}};
@@ -380,6 +411,7 @@ std::optional<MeshHit> TriangleMesh::traverse(const Ray& ray, Interval range) co
     for (;;) {
         const Node& n = nodes_[node];
         if (n.count > 0) {
+            if (tests) *tests += n.count;
             for (std::uint32_t i = n.offset; i < n.offset + n.count; ++i) {
                 const auto [a, b, c] = corners(i);
                 if (const auto hit = intersect_triangle(sheared, a, b, c, range)) {
@@ -421,6 +453,16 @@ std::optional<MeshHit> TriangleMesh::intersect(const Ray& ray, Interval range) c
 
 bool TriangleMesh::occluded(const Ray& ray, Interval range) const {
     return traverse<true>(ray, range).has_value();
+}
+
+std::uint64_t TriangleMesh::triangle_tests(const Ray& ray, Interval range, bool any_hit) const {
+    std::uint64_t tests = 0;
+    if (any_hit) {
+        traverse<true>(ray, range, &tests);
+    } else {
+        traverse<false>(ray, range, &tests);
+    }
+    return tests;
 }
 
 namespace {

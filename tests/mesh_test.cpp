@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -119,6 +120,46 @@ TEST(TriangleMesh, NearestHitIsThatOfTestingEveryTriangle) {
         if (expected->t > 0.01) {
             EXPECT_FALSE(mesh.occluded(ray, {0, expected->t * 0.999}));
         }
+    }
+}
+
+// A shadow ray needs any hit, not the nearest: with 64 triangles across its path whose boxes all
+// overlap where it enters, the nearest-hit search must test every one, and the any-hit query
+// stops at the first triangle it tests.
+TEST(TriangleMesh, AnyHitQueryStopsAtTheFirstHitItFinds) {
+    testing::TestMesh fan;
+    constexpr int kCount = 64;
+    for (int k = 0; k < kCount; ++k) {
+        // In the plane x = c + y, around the x axis at x = c.
+        const double c = 0.01 * k;
+        const auto first = static_cast<std::uint32_t>(fan.vertices.size());
+        fan.vertices.push_back({c - 1, -1, -2});
+        fan.vertices.push_back({c - 1, -1, 2});
+        fan.vertices.push_back({c + 1, 1, 0});
+        fan.triangles.push_back({first, first + 1, first + 2});
+    }
+    const TriangleMesh mesh(testing::obj_of(fan), {}, false);
+    ASSERT_EQ(mesh.triangle_count(), 64u);
+    const Ray ray{Vec3{-5, 0, 0} - mesh.origin(), {1, 0, 0}};
+    EXPECT_EQ(mesh.triangle_tests(ray, {0, kInfinity}, false), 64u);
+    EXPECT_EQ(mesh.triangle_tests(ray, {0, kInfinity}, true), 1u);
+    EXPECT_TRUE(mesh.occluded(ray, {0, kInfinity}));
+    EXPECT_DOUBLE_EQ(mesh.intersect(ray, {0, kInfinity})->t, 5);
+}
+
+// The hierarchy built on several threads is the one built on one, node for node, so that images
+// do not depend on the machine. The mesh is large enough for subtrees to be built in parallel.
+TEST(TriangleMesh, BuildsTheSameHierarchyOnOneThreadAsOnSeveral) {
+    const ObjMesh obj = testing::obj_of(testing::icosphere(6));
+    const TriangleMesh one(obj, {}, false, 1);
+    ASSERT_EQ(one.triangle_count(), 81920u);
+    for (const int threads : {2, 3, 8}) {
+        const TriangleMesh several(obj, {}, false, threads);
+        ASSERT_EQ(several.hierarchy().size(), one.hierarchy().size()) << threads << " threads";
+        EXPECT_TRUE(std::ranges::equal(several.hierarchy(), one.hierarchy()))
+            << threads << " threads";
+        EXPECT_TRUE(std::ranges::equal(several.triangles(), one.triangles()))
+            << threads << " threads";
     }
 }
 

@@ -2,7 +2,8 @@
 # Installs the Debian 12 packages drt needs to build and test; does nothing when all are present.
 # Usage: tools/install-deps.sh [--study] [--bench] [extra-package ...]
 #   --study  also gnuplot-nox, which tools/accuracy-study.sh needs to draw its plots
-#   --bench  also libbenchmark-dev, povray and time, which bench/ needs (docs/performance.md)
+#   --bench  also libbenchmark-dev, povray, time and libembree-dev, which bench/ needs
+#            (docs/performance.md)
 set -euo pipefail
 
 # openexr (exrheader) and chromium (a headless browser loading the regression reports) are for the
@@ -12,7 +13,7 @@ packages=(g++ cmake make pkg-config libtinyxml2-dev libstb-dev libcli11-dev libo
 for arg in "$@"; do
     case "$arg" in
         --study) packages+=(gnuplot-nox) ;;
-        --bench) packages+=(libbenchmark-dev povray time) ;;
+        --bench) packages+=(libbenchmark-dev povray time libembree-dev) ;;
         *) packages+=("$arg") ;;
     esac
 done

@@ -103,9 +103,12 @@ class Bvh {
     bool traverse(const Ray& ray, Interval& range, std::uint64_t planes, Nearest& nearest) const;
     // The one leaf test: the ray parameter inside `range` at which the ray meets primitive p at
     // the ray's time. A mesh writes the triangle it hit and its barycentrics b1, b2 into
-    // `triangle` and `uv`.
+    // `triangle` and `uv`. For kAnyHit, a mesh answers with any hit, range.max for its t and
+    // nothing written.
+    template <bool kAnyHit>
     std::optional<double> hit(const Primitive& p, const Ray& ray, double origin_scale,
                               Interval range, std::uint32_t& triangle, Vec2& uv) const;
+    template <bool kAnyHit>
     std::optional<double> hit_segment(const Primitive& p, const Ray& ray, double origin_scale,
                                       Interval range, std::uint32_t& triangle, Vec2& uv) const;
     // Where primitive p is at `time`, as a ball (for the shadow-ray culling).

@@ -6,9 +6,11 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "drt/math.h"
@@ -43,8 +45,11 @@ class TriangleMesh {
     // Transforms the file's vertices and builds the hierarchy. Triangles of zero area are left
     // out (dropped() counts them). With `smooth`, vertex normals are the file's `vn` where a
     // corner has one, else the angle-weighted normals of the faces around the vertex. Throws
-    // std::domain_error if a transformed coordinate does not fit in single precision.
-    TriangleMesh(const ObjMesh& obj, const MeshTransform& transform, bool smooth);
+    // std::domain_error if a transformed coordinate does not fit in single precision. The
+    // hierarchy is built on `build_threads` threads (0: one per core); the tree is the same
+    // whatever their number.
+    TriangleMesh(const ObjMesh& obj, const MeshTransform& transform, bool smooth,
+                 int build_threads = 0);
 
     std::size_t triangle_count() const { return triangles_.size(); }
     std::size_t dropped() const { return dropped_; }
@@ -57,6 +62,9 @@ class TriangleMesh {
     std::optional<MeshHit> intersect(const Ray& ray, Interval range) const;
     // Whether any triangle meets the ray inside `range` (stops at the first).
     bool occluded(const Ray& ray, Interval range) const;
+    // How many triangles the query (nearest hit, or any hit) tests on its way: what the hierarchy
+    // saves, for tests and benchmarks.
+    std::uint64_t triangle_tests(const Ray& ray, Interval range, bool any_hit) const;
 
     std::array<Vec3, 3> corners(std::uint32_t triangle) const;
     // Unit (p1 - p0) × (p2 - p0): outward for a closed mesh wound counter-clockwise.
@@ -72,8 +80,16 @@ class TriangleMesh {
     // Memory held for geometry and hierarchy.
     std::size_t bytes() const;
 
-  private:
     using Float3 = std::array<float, 3>;
+    // The geometry as stored, for handing the same triangles to another kernel (bench/): the
+    // positions relative to origin(), and each triangle's vertices, in the order whose index
+    // MeshHit::triangle gives.
+    std::span<const Float3> positions() const { return positions_; }
+    std::span<const std::array<std::uint32_t, 3>> triangles() const { return triangles_; }
+    // The hierarchy's nodes as bytes, for telling whether two builds made the same tree.
+    std::span<const std::byte> hierarchy() const { return std::as_bytes(std::span(nodes_)); }
+
+  private:
     // One node is 32 bytes: its box, and either its triangles (a leaf: `count` of them from
     // `offset`) or its second child (an inner node: `count` 0, the first child follows it).
     struct Node {
@@ -84,11 +100,16 @@ class TriangleMesh {
     struct BuildItem;
 
     Vec3 position(std::uint32_t vertex) const;
-    void build_hierarchy();
-    std::uint32_t build(std::vector<BuildItem>& items, std::uint32_t begin, std::uint32_t end,
-                        int depth);
+    void build_hierarchy(int threads);
+    // Builds the subtree of items [begin, end) into `nodes` (its root at the end of `nodes`,
+    // node indices relative to the start of `nodes`); `tasks` > 1 builds second subtrees on
+    // threads of their own, that many at a time at most.
+    static std::uint32_t build(std::vector<BuildItem>& items, std::uint32_t begin,
+                               std::uint32_t end, int depth, std::vector<Node>& nodes, int tasks);
+    // `tests`, when given, counts the triangles tested.
     template <bool kAnyHit>
-    std::optional<MeshHit> traverse(const Ray& ray, Interval range) const;
+    std::optional<MeshHit> traverse(const Ray& ray, Interval range,
+                                    std::uint64_t* tests = nullptr) const;
 
     Vec3 origin_;
     std::vector<Float3> positions_;  // relative to origin_
