@@ -1,6 +1,8 @@
 #include "drt/mesh.h"
 
+#include <immintrin.h>
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -53,25 +55,71 @@ double corner_angle(const Vec3& a, const Vec3& b, const Vec3& c) {
     return std::atan2(length(cross(u, v)), dot(u, v));
 }
 
-// Slab test of a box against a ray with precomputed reciprocal direction. A NaN from 0 · ∞ (the
-// origin on a slab the ray runs along) leaves the interval as it was, which keeps the box.
-// The far end is widened by the test's own rounding (Pharr, Jakob & Humphreys, section 6.8.2 of
-// the 4th edition), so that a box never misses a ray its triangle meets.
-struct BoxRay {
-    Vec3 origin, inv_dir;
+// A ray as the 4-wide box test takes it: in single precision, and still conservative, so that
+// a box never misses a ray its triangle meets (the triangle test, in double, decides). The
+// origin rounded to float moves the ray by up to `err` on each axis, which widens each slab by
+// err / |d| in t (`slack`, doubled for the rounding of the additions); the remaining roundings
+// are relative and covered by widening the far end, as for doubles (Pharr, Jakob & Humphreys,
+// section 6.8.2 of the 4th edition). An axis the ray does not move along (or so little that
+// 1 / d overflows a float) is tested by where the origin is instead, since ±∞ · 0 would be NaN.
+struct WideRay {
+    __m128 origin[3], inv_dir[3], slack[3];
+    __m128 below[3], above[3];  // a flat axis's origin, widened down and up
+    int flat = 0;               // bit k: axis k is flat
 
-    bool hits(const std::array<float, 3>& lo, const std::array<float, 3>& hi, Interval range,
-              double& entry) const {
-        double near = range.min, far = range.max;
+    WideRay(const Ray& ray, Interval range) {
+        // No hit on a mesh of float coordinates is farther than this.
+        const double reach = std::min(range.max, 1e39 + 2 * max_abs_component(ray.origin));
         for (int k = 0; k < 3; ++k) {
-            double t0 = (lo[k] - origin[k]) * inv_dir[k];
-            double t1 = (hi[k] - origin[k]) * inv_dir[k];
-            if (t0 > t1) std::swap(t0, t1);
-            near = std::max(near, t0);
-            far = std::min(far, t1 * (1 + 2 * detail::gamma(3)));
+            const auto o = static_cast<float>(ray.origin[k]);
+            const double inv = 1 / ray.dir[k];
+            const double err = std::abs(ray.origin[k] - o);
+            origin[k] = _mm_set1_ps(o);
+            if (!(std::abs(inv) <= std::numeric_limits<float>::max())) {
+                flat |= 1 << k;
+                const double drift = 2 * err + std::abs(ray.dir[k]) * reach;
+                below[k] = _mm_set1_ps(rounded_down(ray.origin[k] - drift));
+                above[k] = _mm_set1_ps(rounded_up(ray.origin[k] + drift));
+                continue;
+            }
+            inv_dir[k] = _mm_set1_ps(static_cast<float>(inv));
+            slack[k] = _mm_set1_ps(rounded_up(2 * err * std::abs(inv) * (1 + 1e-6)));
         }
-        entry = near;
-        return near <= far;
+    }
+
+    // The children whose boxes the ray meets inside [near, far] (bit k for child k), and where
+    // it enters each.
+    int hits(const float (&lo)[3][4], const float (&hi)[3][4], float near, float far,
+             __m128& entry) const {
+        __m128 enter = _mm_set1_ps(near), leave = _mm_set1_ps(far);
+        __m128 inside = _mm_cmple_ps(enter, leave);
+        for (int k = 0; k < 3; ++k) {
+            const __m128 l = _mm_load_ps(lo[k]), h = _mm_load_ps(hi[k]);
+            if (flat >> k & 1) {
+                inside = _mm_and_ps(
+                    inside, _mm_and_ps(_mm_cmple_ps(l, above[k]), _mm_cmpge_ps(h, below[k])));
+                continue;
+            }
+            const __m128 t0 = _mm_mul_ps(_mm_sub_ps(l, origin[k]), inv_dir[k]);
+            const __m128 t1 = _mm_mul_ps(_mm_sub_ps(h, origin[k]), inv_dir[k]);
+            enter = _mm_max_ps(_mm_sub_ps(_mm_min_ps(t0, t1), slack[k]), enter);
+            leave = _mm_min_ps(_mm_add_ps(_mm_max_ps(t0, t1), slack[k]), leave);
+        }
+        entry = enter;
+        return _mm_movemask_ps(
+            _mm_and_ps(inside, _mm_cmple_ps(enter, _mm_mul_ps(leave, _mm_set1_ps(kWiden)))));
+    }
+
+    // 2γ(5) in single precision and some: the relative rounding of the slab distances.
+    static constexpr float kWiden = 1 + 0x1p-19f;
+
+    static float rounded_up(double x) {
+        const auto f = static_cast<float>(x);
+        return f < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+    }
+    static float rounded_down(double x) {
+        const auto f = static_cast<float>(x);
+        return f > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
     }
 };
 
@@ -80,7 +128,9 @@ constexpr int kBins = 16;
 // Past this depth a node is split at its median, so that no path is longer than 40 + log2(n)
 // nodes, which the traversal's stack holds.
 constexpr int kSahDepth = 40;
-constexpr int kStackSize = 128;
+// A node pushes at most three children besides the one it visits next, and no path is longer
+// than 64 nodes.
+constexpr int kStackSize = 256;
 // Subtrees of fewer triangles are built on the thread that reached them: a thread costs about
 // what building a few thousand triangles does.
 constexpr std::uint32_t kParallelBuild = 16384;
@@ -241,7 +291,7 @@ Vec3 TriangleMesh::lifted(std::uint32_t triangle, const Barycentrics& b) const {
 
 Bounds TriangleMesh::bounds() const {
     if (nodes_.empty()) return {};
-    return {to_vec3(nodes_[0].lo), to_vec3(nodes_[0].hi)};
+    return {to_vec3(lo_), to_vec3(hi_)};
 }
 
 std::size_t TriangleMesh::bytes() const {
@@ -266,11 +316,17 @@ void TriangleMesh::build_hierarchy(int threads) {
         }
     }
     // At most 2n - 1 nodes; a leaf holds two triangles or more unless it is alone.
-    nodes_.reserve(items.size());
+    std::vector<BinaryNode> binary;
+    binary.reserve(items.size());
     // More tasks than threads, so that the unequal halves SAH splits make still keep every
     // thread busy to the end.
-    build(items, 0, static_cast<std::uint32_t>(items.size()), 0, nodes_,
+    build(items, 0, static_cast<std::uint32_t>(items.size()), 0, binary,
           threads > 1 ? 4 * threads : 1);
+    lo_ = binary[0].lo;
+    hi_ = binary[0].hi;
+    // Each wide node takes the place of at least three binary ones (but a root that is a leaf).
+    nodes_.reserve(binary.size() / 3 + 1);
+    widen(binary, 0);
     nodes_.shrink_to_fit();
     std::vector<std::array<std::uint32_t, 3>> ordered(triangles_.size());
     for (std::size_t i = 0; i < items.size(); ++i) ordered[i] = triangles_[items[i].triangle];
@@ -278,7 +334,7 @@ void TriangleMesh::build_hierarchy(int threads) {
 }
 
 std::uint32_t TriangleMesh::build(std::vector<BuildItem>& items, std::uint32_t begin,
-                                  std::uint32_t end, int depth, std::vector<Node>& nodes,
+                                  std::uint32_t end, int depth, std::vector<BinaryNode>& nodes,
                                   int tasks) {
     const auto index = static_cast<std::uint32_t>(nodes.size());
     nodes.push_back({});
@@ -368,7 +424,7 @@ std::uint32_t TriangleMesh::build(std::vector<BuildItem>& items, std::uint32_t b
     if (tasks > 1 && count >= kParallelBuild) {
         // The second subtree on a thread of its own, into nodes of its own, then appended after
         // the first: where the sequential build would have put it, node for node.
-        std::vector<Node> second_nodes;
+        std::vector<BinaryNode> second_nodes;
         {
             const std::jthread worker([&] {
                 second_nodes.reserve(end - mid);
@@ -377,7 +433,7 @@ std::uint32_t TriangleMesh::build(std::vector<BuildItem>& items, std::uint32_t b
             build(items, begin, mid, depth + 1, nodes, tasks - tasks / 2);
         }
         second = static_cast<std::uint32_t>(nodes.size());
-        for (Node n : second_nodes) {
+        for (BinaryNode n : second_nodes) {
             if (n.count == 0) n.offset += second;
             nodes.push_back(n);
         }
@@ -390,61 +446,110 @@ std::uint32_t TriangleMesh::build(std::vector<BuildItem>& items, std::uint32_t b
     return index;
 }
 
+std::uint32_t TriangleMesh::widen(const std::vector<BinaryNode>& binary, std::uint32_t node) {
+    const auto index = static_cast<std::uint32_t>(nodes_.size());
+    nodes_.push_back({});
+    // The node's binary children, then, while there is room, the inner one of largest surface
+    // area replaced by its two children: what a 4-wide node saves is the most boxes entered.
+    std::array<std::uint32_t, 4> kids{};
+    int n = 0;
+    if (binary[node].count > 0) {
+        kids[n++] = node;  // the whole tree is one leaf
+    } else {
+        kids[n++] = node + 1;
+        kids[n++] = binary[node].offset;
+    }
+    const auto area = [&](std::uint32_t k) {
+        return Bounds{to_vec3(binary[k].lo), to_vec3(binary[k].hi)}.surface_area();
+    };
+    while (n < 4) {
+        int open = -1;
+        for (int k = 0; k < n; ++k) {
+            if (binary[kids[k]].count == 0 && (open < 0 || area(kids[k]) > area(kids[open])))
+                open = k;
+        }
+        if (open < 0) break;
+        const std::uint32_t opened = kids[open];
+        kids[open] = opened + 1;
+        kids[n++] = binary[opened].offset;
+    }
+    // Unused slots keep boxes at +∞ on both sides, which no ray enters, but `children` is what
+    // the traversal reads.
+    for (int a = 0; a < 3; ++a) {
+        for (int k = 0; k < 4; ++k) {
+            nodes_[index].lo[a][k] = nodes_[index].hi[a][k] =
+                std::numeric_limits<float>::infinity();
+        }
+    }
+    nodes_[index].children = static_cast<std::uint32_t>(n);
+    for (int k = 0; k < n; ++k) {
+        const BinaryNode& child = binary[kids[k]];
+        for (int a = 0; a < 3; ++a) {
+            nodes_[index].lo[a][k] = child.lo[a];
+            nodes_[index].hi[a][k] = child.hi[a];
+        }
+        // (widen appends to nodes_: no reference into it is held across the call.)
+        const std::uint32_t target = child.count > 0 ? child.offset : widen(binary, kids[k]);
+        nodes_[index].child[k] = target;
+        nodes_[index].count[k] = static_cast<std::uint16_t>(child.count);
+    }
+    return index;
+}
+
 template <bool kAnyHit>
 std::optional<MeshHit> TriangleMesh::traverse(const Ray& ray, Interval range,
                                               std::uint64_t* tests) const {
     if (nodes_.empty()) return std::nullopt;
     const ShearedRay sheared(ray);
-    const BoxRay box_ray{ray.origin, {1 / ray.dir.x, 1 / ray.dir.y, 1 / ray.dir.z}};
+    const WideRay wide(ray, range);
+    const float near = WideRay::rounded_down(range.min);
+    float far = WideRay::rounded_up(range.max);
     std::optional<MeshHit> best;
-    // Nodes still to visit, with where the ray enters their boxes: one that a nearer hit has
-    // since put out of range is skipped.
+    // Children still to visit (a node, or a leaf's triangles), with where the ray enters their
+    // boxes: one that a nearer hit has since put out of range is skipped.
     struct Pending {
-        std::uint32_t node;
-        double entry;
+        std::uint32_t child;
+        std::uint32_t count;
+        float entry;
     };
     std::array<Pending, kStackSize> stack;
     int top = 0;
-    double entry = 0;
-    if (!box_ray.hits(nodes_[0].lo, nodes_[0].hi, range, entry)) return std::nullopt;
-    std::uint32_t node = 0;
-    for (;;) {
-        const Node& n = nodes_[node];
-        if (n.count > 0) {
-            if (tests) *tests += n.count;
-            for (std::uint32_t i = n.offset; i < n.offset + n.count; ++i) {
+    stack[top++] = {0, 0, near};
+    while (top > 0) {
+        const Pending p = stack[--top];
+        if (p.entry > far * WideRay::kWiden) continue;
+        if (p.count > 0) {
+            for (std::uint32_t i = p.child; i < p.child + p.count; ++i) {
+                if (tests) ++*tests;
                 const auto [a, b, c] = corners(i);
                 if (const auto hit = intersect_triangle(sheared, a, b, c, range)) {
                     best = MeshHit{hit->t, i, hit->b};
                     if constexpr (kAnyHit) return best;
                     range.max = hit->t;
+                    far = WideRay::rounded_up(range.max);
                 }
             }
-        } else {
-            const std::uint32_t first = node + 1, second = n.offset;
-            double first_entry = 0, second_entry = 0;
-            const bool hit_first =
-                box_ray.hits(nodes_[first].lo, nodes_[first].hi, range, first_entry);
-            const bool hit_second =
-                box_ray.hits(nodes_[second].lo, nodes_[second].hi, range, second_entry);
-            if (hit_first && hit_second) {
-                const bool first_nearer = first_entry <= second_entry;
-                stack[top++] =
-                    first_nearer ? Pending{second, second_entry} : Pending{first, first_entry};
-                node = first_nearer ? first : second;
-                continue;
-            }
-            if (hit_first || hit_second) {
-                node = hit_first ? first : second;
-                continue;
-            }
+            continue;
         }
-        do {
-            if (top == 0) return best;
-            --top;
-        } while (stack[top].entry > range.max);
-        node = stack[top].node;
+        const Node& node = nodes_[p.child];
+        __m128 entries;
+        int mask = wide.hits(node.lo, node.hi, near, far, entries) & ((1 << node.children) - 1);
+        if (mask == 0) continue;
+        alignas(16) float entry[4];
+        _mm_store_ps(entry, entries);
+        // Pushed farthest first, so that the nearest is visited next.
+        std::array<int, 4> order{};
+        int n = 0;
+        for (; mask != 0; mask &= mask - 1)
+            order[n++] = std::countr_zero(static_cast<unsigned>(mask));
+        std::sort(order.begin(), order.begin() + n,
+                  [&](int x, int y) { return entry[x] > entry[y]; });
+        for (int k = 0; k < n; ++k) {
+            const int c = order[k];
+            stack[top++] = {node.child[c], node.count[c], entry[c]};
+        }
     }
+    return best;
 }
 
 std::optional<MeshHit> TriangleMesh::intersect(const Ray& ray, Interval range) const {

@@ -90,12 +90,24 @@ class TriangleMesh {
     std::span<const std::byte> hierarchy() const { return std::as_bytes(std::span(nodes_)); }
 
   private:
-    // One node is 32 bytes: its box, and either its triangles (a leaf: `count` of them from
-    // `offset`) or its second child (an inner node: `count` 0, the first child follows it).
-    struct Node {
+    // The build's binary tree, 32 bytes a node: its box, and either its triangles (a leaf:
+    // `count` of them from `offset`) or its second child (an inner node: `count` 0, the first
+    // child follows it).
+    struct BinaryNode {
         Float3 lo, hi;
         std::uint32_t offset;
         std::uint32_t count;
+    };
+    // The tree traversed has up to four children a node, their boxes side by side so that one
+    // 4-wide SIMD test tests them all (Wald, Benthin & Boulos 2008; Dammertz et al. 2008):
+    // 128 bytes a node. A child is a node (`count` 0, `child` its index) or a leaf (`count`
+    // triangles from `child`); the first `children` slots are used.
+    struct alignas(16) Node {
+        float lo[3][4], hi[3][4];  // [axis][child]
+        std::uint32_t child[4];
+        std::uint16_t count[4];
+        std::uint32_t children;
+        std::uint32_t unused;  // 0: a node has no padding bytes of unknown value
     };
     struct BuildItem;
 
@@ -105,7 +117,11 @@ class TriangleMesh {
     // node indices relative to the start of `nodes`); `tasks` > 1 builds second subtrees on
     // threads of their own, that many at a time at most.
     static std::uint32_t build(std::vector<BuildItem>& items, std::uint32_t begin,
-                               std::uint32_t end, int depth, std::vector<Node>& nodes, int tasks);
+                               std::uint32_t end, int depth, std::vector<BinaryNode>& nodes,
+                               int tasks);
+    // Turns the binary subtree at `node` into 4-wide nodes appended to nodes_; returns the index
+    // of the one made for `node`.
+    std::uint32_t widen(const std::vector<BinaryNode>& binary, std::uint32_t node);
     // `tests`, when given, counts the triangles tested.
     template <bool kAnyHit>
     std::optional<MeshHit> traverse(const Ray& ray, Interval range,
@@ -116,6 +132,7 @@ class TriangleMesh {
     std::vector<Float3> normals_;    // per vertex, unit; empty for a flat mesh
     std::vector<std::array<std::uint32_t, 3>> triangles_;  // in leaf order
     std::vector<Node> nodes_;
+    Float3 lo_{}, hi_{};  // bounds of every triangle
     std::size_t dropped_ = 0;
 };
 
