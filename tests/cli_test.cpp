@@ -1007,6 +1007,70 @@ TEST_F(CliTest, BatchGoesOnPastScenesThatFailInLoadingOrRenderingAndPrintsItsSum
         << r.out;
 }
 
+// ---- the error estimate ------------------------------------------------------------------------
+
+TEST_F(CliTest, ErrorImageHoldsEachPixelsStandardErrorAndZeroForAFlatScene) {
+    const Outcome r = run({"scene.xml", "-o", "out.pfm", "--error-image", "err.exr", "--stats",
+                           "s.json", "--sampler", "random"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("spp, "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(" s, estimated RMSE 0."), std::string::npos) << r.err;
+    const Image error = read_image(file("err.exr"));
+    EXPECT_EQ(error.width, 24);
+    EXPECT_EQ(error.height, 16);
+    // Some pixels are noisy (the penumbra, the edges), none negative or not finite.
+    EXPECT_GT(*std::max_element(error.rgb.begin(), error.rgb.end()), 0.01f);
+    for (const float v : error.rgb) EXPECT_TRUE(std::isfinite(v) && v >= 0) << v;
+    const std::string json = read_bytes(file("s.json"));
+    EXPECT_NE(json.find("\"estimated_rmse\": 0."), std::string::npos) << json;
+    EXPECT_NE(json.find("\"estimated_relmse\": "), std::string::npos) << json;
+
+    // A scene of nothing but background: every sample alike, no error anywhere.
+    write_bytes(file("flat.xml"),
+                "<Scene>\n  <Image Width=\"6\" Height=\"4\"/>\n"
+                "  <Render Samples=\"4\"/>\n  <Background r=\"0.5\" g=\"0.2\" "
+                "b=\"0.1\"/>\n</Scene>\n");
+    const Outcome flat = run({"flat.xml", "-o", "flat.pfm", "--error-image", "flat-err.pfm"});
+    ASSERT_EQ(flat.status, 0) << flat.err;
+    EXPECT_NE(flat.err.find("estimated RMSE 0)"), std::string::npos) << flat.err;
+    const Image zero = read_image(file("flat-err.pfm"));
+    EXPECT_EQ(zero.width, 6);
+    EXPECT_EQ(zero.rgb, std::vector<float>(6 * 4 * 3, 0.0f));
+}
+
+TEST_F(CliTest, OneSampleHasNoEstimateAndSaysWhy) {
+    const Outcome r = run({"scene.xml", "-o", "out.pfm", "--spp", "1", "--stats", "-"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("estimated RMSE n/a (1 spp takes the pixel centre: no spread to measure)"),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.out.find("\"estimated_rmse\": null, \"estimated_relmse\": null, "
+                         "\"estimate_unavailable\": \"1 spp takes the pixel centre: no spread "
+                         "to measure\""),
+              std::string::npos)
+        << r.out;
+}
+
+TEST_F(CliTest, ABadErrorImagePathExitsTwoBeforeRendering) {
+    const std::vector<std::pair<std::string, std::string>> cases{
+        {"missing/e.pfm",
+         "drt: --error-image missing/e.pfm: cannot create file: No such file or "
+         "directory\n"},
+        {"e.txt",
+         "drt: --error-image e.txt: unsupported image format '.txt' (use .png, .bmp, "
+         ".pfm or .exr)\n"}};
+    for (const auto& [path, message] : cases) {
+        const Outcome r = run({"scene.xml", "-o", "out.pfm", "--error-image", path});
+        EXPECT_EQ(r.status, 2) << path;
+        EXPECT_EQ(r.err, message);
+        EXPECT_FALSE(fs::exists(file("out.pfm"))) << path;
+    }
+    const Outcome batch = run({"scene.xml", "scene.xml", "-o", "dir/", "--error-image", "e.pfm"});
+    EXPECT_EQ(batch.status, 2);
+    EXPECT_EQ(batch.err,
+              "drt: --error-image takes one scene, not a batch\nRun 'drt --help' for usage.\n");
+}
+
 #if !defined(__SANITIZE_ADDRESS__)  // ASan reserves terabytes of address space up front
 TEST_F(CliTest, AllocationFailureInARenderFailsThatSceneOnly) {
     // 8192 x 8192 pixels: within the limits, but its 768 MiB image cannot be had under a 512 MiB
