@@ -59,7 +59,7 @@ TEST(EstimateError, OneSampleAndTooFewRunsAreNotANumber) {
     two_runs.runs_pixels = {2, 0, 0};
     const ErrorEstimate sobol =
         estimate_error(image, spread, two_runs, 2, SpreadKind::kProgressive);
-    EXPECT_EQ(sobol.unavailable, "the sobol estimate needs 4 spp or more");
+    EXPECT_EQ(sobol.unavailable, "the sobol estimate needs 8 spp or more");
 }
 
 TEST(EstimateError, IndependentSpreadsAverageOverPixelsAndChannels) {

@@ -64,7 +64,7 @@ struct ErrorEstimate {
 // The expected RMSE and relative MSE of `image` against the converged image from the per-pixel
 // spreads (the same size) and the image's sums. relMSE stands x^2 - variance (at least 0) for
 // the unknown ref^2. `spp` is the samples per pixel asked for: with 1 the pixel centre is taken
-// and nothing can be estimated, and a progressive sampler needs 4 (two sizes of run). Throws
+// and nothing can be estimated, and a progressive sampler needs 8 (three sizes of run). Throws
 // ImageError when the sizes differ.
 ErrorEstimate estimate_error(const Image& image, const Image& spread, const ErrorSums& sums,
                              int spp, SpreadKind kind);
