@@ -939,12 +939,61 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
     return status;
 }
 
+// Pilot rounds (progressive.h) of `scene` and what they predict for reaching `target`.
+struct GoalForecast {
+    std::vector<ProgressiveRound> pilots;
+    std::optional<Prediction> prediction;
+};
+
+GoalForecast forecast(Scene& scene, double target, int threads) {
+    ProgressiveGoal goal;
+    goal.target_error = target;
+    goal.max_samples = kPilotSamples[std::size(kPilotSamples) - 1];
+    RenderJobOptions options;
+    options.threads = threads;
+    GoalForecast f;
+    const ProgressiveResult pilots = render_progressively(scene, options, goal);
+    f.pilots = pilots.rounds;
+    if (pilots.target_met) {
+        f.prediction = Prediction{pilots.samples, pilots.rounds.back().seconds};
+    } else {
+        f.prediction = predict(pilots.rounds, target, kMaxSamples);
+    }
+    return f;
+}
+
+std::string forecast_text(const GoalForecast& f, double target) {
+    std::ostringstream text;
+    text << "pilots:";
+    for (const ProgressiveRound& r : f.pilots) {
+        text << " " << r.spp << " spp " << std::fixed << std::setprecision(3) << r.seconds
+             << " s, estimated rmse " << std::defaultfloat
+             << (r.error ? short_number(*r.error) : std::string("n/a")) << ";";
+    }
+    text << "\npredicted for --target-error " << short_number(target) << ": ";
+    if (f.prediction) {
+        text << f.prediction->spp << " spp, " << std::fixed << std::setprecision(2)
+             << f.prediction->seconds << " s on this machine" << std::defaultfloat;
+    } else {
+        text << "n/a (the pilots give no error estimate to extrapolate)";
+    }
+    return text.str() + "\n";
+}
+
 int info_command(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
     CLI::App app{"Show what a scene contains and which effects it calls for", "drt info"};
     std::string scene_path;
     Overrides overrides;
+    std::optional<double> target;
+    int threads = 0;
     app.add_option("scene", scene_path, "Scene file")->required();
     overrides.add_to(app);
+    app.add_option("--target-error", target,
+                   "Also predict the samples per pixel and the time a render to this estimated "
+                   "RMSE takes here, from short pilot renders")
+        ->check(finite_positive());
+    app.add_option("--threads", threads, "Worker threads of the pilot renders (default: all cores)")
+        ->check(integer_in(1, kMaxThreads));
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp&) {
@@ -959,6 +1008,7 @@ int info_command(int argc, const char* const* argv, std::ostream& out, std::ostr
         for (const std::string& w : loaded.warnings) err << w << "\n";
         overrides.apply(loaded.scene.settings);
         out << describe(loaded.scene, plan_render(loaded.scene));
+        if (target) out << forecast_text(forecast(loaded.scene, *target, threads), *target);
     } catch (const SceneError& e) {
         err << e.what() << "\n";
         return kBadInput;
@@ -979,9 +1029,14 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
     Overrides overrides;
     AdaptiveFlags adaptive;
     int threads = 0;
+    std::optional<double> target;
     app.add_option("scene", scene_path, "Scene file")->required();
     overrides.add_to(app);
     app.remove_option(app.get_option("--spp"));  // here a list, not one count
+    app.add_option("--target-error", target,
+                   "Predict from pilot renders what reaching this estimated RMSE takes, and show "
+                   "it next to where the measured RMSE reaches it")
+        ->check(finite_positive());
     app.add_option("--spp", counts_text, "Comma-separated sample counts (default 1,4,16,64,256)");
     app.add_option("--reference", reference_path,
                    "Reference image (.pfm or .exr) to measure against; default: render one");
@@ -1044,6 +1099,11 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
                 << options.adaptive->min_samples;
         }
         out << "\n";
+        std::optional<GoalForecast> goal;
+        if (target) {
+            goal = forecast(scene, *target, threads);
+            out << forecast_text(*goal, *target);
+        }
         Image reference;
         if (!reference_path.empty()) {
             reference = read_image(reference_path);
@@ -1097,6 +1157,16 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
         };
         out << "slope of log RMSE against log samples: " << slope(c.slope_vs_spp) << "\n"
             << "slope of log RMSE against log seconds: " << slope(c.slope_vs_seconds) << "\n";
+        if (goal) {
+            out << "measured for rmse " << short_number(*target) << ": ";
+            if (const auto reach = measured_reach(c, *target)) {
+                out << std::fixed << std::setprecision(0) << reach->spp << " spp, "
+                    << std::setprecision(2) << reach->seconds << " s" << std::defaultfloat
+                    << " (interpolated between the counts above)\n";
+            } else {
+                out << "not reached by the counts above\n";
+            }
+        }
         if (!csv.empty()) {
             std::string text = convergence_csv(c);
             text.pop_back();  // write_text_atomically ends the file with its own newline

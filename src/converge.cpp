@@ -110,6 +110,25 @@ Convergence measure_convergence(Scene& scene, const std::vector<int>& spps, cons
     return c;
 }
 
+std::optional<Reach> measured_reach(const Convergence& c, double target) {
+    const ConvergencePoint* before = nullptr;
+    for (const ConvergencePoint& p : c.points) {
+        if (!p.fitted) continue;
+        if (p.rmse <= target) {
+            if (!before || before->rmse <= 0 || p.rmse <= 0) return Reach{double(p.spp), p.seconds};
+            // Log-linear in both: t in [0, 1] from `before` to `p`.
+            const double t = std::log(target / before->rmse) / std::log(p.rmse / before->rmse);
+            const auto between = [t](double a, double b) {
+                return a > 0 && b > 0 ? std::exp(std::log(a) + t * (std::log(b) - std::log(a)))
+                                      : a + t * (b - a);
+            };
+            return Reach{between(before->spp, p.spp), between(before->seconds, p.seconds)};
+        }
+        before = &p;
+    }
+    return std::nullopt;
+}
+
 std::string convergence_csv(const Convergence& c) {
     std::ostringstream out;
     out << std::setprecision(9);

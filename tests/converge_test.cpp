@@ -235,5 +235,27 @@ TEST(ConvergeCli, RefusesBadInput) {
     EXPECT_EQ(r.status, 2);
 }
 
+TEST(Converge, MeasuredReachInterpolatesLogLogBetweenTheCountsAroundTheTarget) {
+    Convergence c;
+    // 1 spp (pixel centres) is left out even though it is below every target here.
+    const auto point = [](int spp, double seconds, double rmse, bool fitted) {
+        ConvergencePoint p;
+        p.spp = spp, p.seconds = seconds, p.rmse = rmse, p.fitted = fitted;
+        return p;
+    };
+    c.points = {point(1, 0.1, 0.0001, false), point(4, 1, 0.04, true), point(16, 4, 0.02, true),
+                point(64, 16, 0.01, true)};
+    // Halfway (in log) between 0.02 and 0.01: halfway between 16 and 64 spp, 4 and 16 s.
+    const auto mid = measured_reach(c, 0.01 * std::sqrt(2.0));
+    ASSERT_TRUE(mid);
+    EXPECT_NEAR(mid->spp, 32, 1e-9);
+    EXPECT_NEAR(mid->seconds, 8, 1e-9);
+    const auto first = measured_reach(c, 0.05);
+    ASSERT_TRUE(first);
+    EXPECT_EQ(first->spp, 4);
+    EXPECT_EQ(first->seconds, 1);
+    EXPECT_FALSE(measured_reach(c, 0.001));
+}
+
 }  // namespace
 }  // namespace drt

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,14 @@ RenderResult render_with(Scene& scene, int spp, std::uint64_t seed, const Render
 Convergence measure_convergence(Scene& scene, const std::vector<int>& spps, const Image& reference,
                                 const RenderOptions& options,
                                 const std::function<void(const ConvergencePoint&)>& on_point = {});
+
+// Where the measured RMSE falls to `target`: the samples and seconds interpolated log-log
+// between the two fitted points on either side of it (the first fitted point itself when it is
+// already there); absent when no measured count reaches it.
+struct Reach {
+    double spp = 0, seconds = 0;
+};
+std::optional<Reach> measured_reach(const Convergence& c, double target);
 
 // "spp,seconds,rmse,relmse,mean_spp,cpu_seconds,fitted,estimated_rmse,estimated_relmse" and one
 // line per point; the estimates are empty where there are none.
