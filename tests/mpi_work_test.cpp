@@ -157,6 +157,16 @@ TEST_P(MpiProcessesAndThreads, AdaptiveRenderIsTheSingleProcesssBitsAndRayCounts
     EXPECT_EQ(r.out + r.err, "");  // -q: nothing from any process
 }
 
+TEST_F(MpiCli, TargetErrorGivesTheSingleProcesssBits) {
+    // Every round's count is decided on the leader and shared: the same rounds as one process.
+    const std::vector<std::string> goal{"--target-error", "0.02", "-q"};
+    ASSERT_EQ(run(small(kMotion, "one.pfm", goal, "32x24")).status, 0);
+    const Outcome r = run_mpi(2, small(kMotion, "two.pfm", goal, "32x24"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(bytes("two.pfm"), bytes("one.pfm"));
+    EXPECT_EQ(r.out + r.err, "");
+}
+
 INSTANTIATE_TEST_SUITE_P(KProcessesByThreads, MpiProcessesAndThreads,
                          ::testing::Values(std::pair{1, 1}, std::pair{1, 2}, std::pair{2, 1},
                                            std::pair{2, 2}, std::pair{3, 1}, std::pair{3, 2}));

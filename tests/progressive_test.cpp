@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "drt/converge.h"
+#include "drt/image.h"
 #include "run_drt.h"
 
 namespace drt {
@@ -167,6 +168,54 @@ TEST_F(GoalCli, TimeLimitStopsByTheLimitWithThePlainRenderOfTheCountReached) {
     plain.insert(plain.end(), size.begin(), size.end());
     ASSERT_EQ(run(plain).status, 0);
     EXPECT_EQ(bytes("limited.pfm"), bytes("plain.pfm"));
+}
+
+TEST_F(GoalCli, TargetErrorIsMetAgainstAHighSampleReference) {
+    // The estimate is honest to within 1.25 (accuracy.md), and the rounds stop at or below E.
+    const double target = 0.01;
+    for (const std::string sampler : {"stratified", "random", "sobol"}) {
+        const std::vector<std::string> common{"--width",   "32",    "--height", "24",
+                                              "--sampler", sampler, "-q"};
+        std::vector<std::string> goal{"scene.xml", "--target-error", "0.01",  "-o",
+                                      "goal.pfm",  "--stats",        "s.json"};
+        goal.insert(goal.end(), common.begin(), common.end());
+        ASSERT_EQ(run(goal).status, 0);
+        EXPECT_NE(bytes("s.json").find("\"target_met\": true"), std::string::npos) << sampler;
+        // Seed 4, not the render's 3: the reference's noise is independent of the render's.
+        std::vector<std::string> reference{"scene.xml", "--spp", "2048",   "--seed",
+                                           "4",         "-o",    "ref.pfm"};
+        reference.insert(reference.end(), common.begin(), common.end());
+        ASSERT_EQ(run(reference).status, 0);
+        const double error = rmse(read_image(dir_ / "goal.pfm"), read_image(dir_ / "ref.pfm"));
+        EXPECT_LE(error, 1.25 * target) << sampler;
+        // And not far below it: the rounds did not overshoot to a needlessly large count.
+        EXPECT_GE(error, 0.4 * target) << sampler;
+    }
+}
+
+TEST_F(GoalCli, TargetErrorGivesTheSameBitsForAnyThreadCount) {
+    std::vector<std::string> images;
+    for (const std::string threads : {"1", "2"}) {
+        const Outcome r = run({"scene.xml", "--target-error", "0.01", "--width", "32", "--height",
+                               "24", "-o", "t" + threads + ".pfm", "--threads", threads});
+        ASSERT_EQ(r.status, 0) << r.err;
+        images.push_back(bytes("t" + threads + ".pfm"));
+    }
+    EXPECT_EQ(images[0], images[1]);
+}
+
+TEST_F(GoalCli, InfoPredictsTheSamplesAndTimeFromPilots) {
+    const Outcome r = run({"info", "scene.xml", "--target-error", "0.005"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::regex line(
+        "\npilots: 8 spp [0-9.]+ s, estimated rmse [0-9.e-]+; 32 spp [0-9.]+ s, estimated rmse "
+        "[0-9.e-]+;\npredicted for --target-error 0.005: [0-9]+ spp, [0-9.]+ s on this machine\n$");
+    EXPECT_TRUE(std::regex_search(r.out, line)) << r.out;
+    const Outcome bad = run({"info", "scene.xml", "--target-error", "0"});
+    EXPECT_EQ(bad.status, 2);
+    EXPECT_EQ(bad.err,
+              "drt info: --target-error: must be a finite positive number, got 0\n"
+              "Run 'drt info --help' for usage.\n");
 }
 
 }  // namespace
