@@ -972,8 +972,14 @@ std::string forecast_text(const GoalForecast& f, double target) {
     }
     text << "\npredicted for --target-error " << short_number(target) << ": ";
     if (f.prediction) {
+        // The goal render repeats the pilots before its own rounds.
+        double pilots = 0;
+        for (const ProgressiveRound& r : f.pilots) pilots += r.seconds;
+        const bool more = f.prediction->spp > f.pilots.back().spp;
         text << f.prediction->spp << " spp, " << std::fixed << std::setprecision(2)
-             << f.prediction->seconds << " s on this machine" << std::defaultfloat;
+             << pilots + (more ? f.prediction->seconds : 0) << " s on this machine (--spp "
+             << f.prediction->spp << " alone: " << f.prediction->seconds << " s)"
+             << std::defaultfloat;
     } else {
         text << "n/a (the pilots give no error estimate to extrapolate)";
     }

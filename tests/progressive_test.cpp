@@ -209,7 +209,8 @@ TEST_F(GoalCli, InfoPredictsTheSamplesAndTimeFromPilots) {
     ASSERT_EQ(r.status, 0) << r.err;
     const std::regex line(
         "\npilots: 8 spp [0-9.]+ s, estimated rmse [0-9.e-]+; 32 spp [0-9.]+ s, estimated rmse "
-        "[0-9.e-]+;\npredicted for --target-error 0.005: [0-9]+ spp, [0-9.]+ s on this machine\n$");
+        "[0-9.e-]+;\npredicted for --target-error 0.005: ([0-9]+) spp, [0-9.]+ s on this machine "
+        "\\(--spp \\1 alone: [0-9.]+ s\\)\n$");
     EXPECT_TRUE(std::regex_search(r.out, line)) << r.out;
     const Outcome bad = run({"info", "scene.xml", "--target-error", "0"});
     EXPECT_EQ(bad.status, 2);
