@@ -146,11 +146,11 @@ TEST_F(GoalCli, SppIsTheMaximumAndTheImageIsThePlainRenderOfTheCountReached) {
 }
 
 TEST_F(GoalCli, TimeLimitStopsByTheLimitWithThePlainRenderOfTheCountReached) {
-    // The random sampler's time per sample is constant, and 48 tiles let a round be stopped
+    // The random sampler's time per sample is constant, and 12 tiles let a round be stopped
     // between tiles. The largest count, 65536 spp, takes minutes: the limit stops the rounds.
-    const std::vector<std::string> size{"--width", "128", "--height", "96", "--sampler", "random"};
-    const double limit = 1.0;
-    std::vector<std::string> args{"scene.xml",   "--time-limit", "1", "-o",
+    const std::vector<std::string> size{"--width", "64", "--height", "48", "--sampler", "random"};
+    const double limit = 3.0;  // room for more than the pilots on a loaded machine
+    std::vector<std::string> args{"scene.xml",   "--time-limit", "3", "-o",
                                   "limited.pfm", "--threads",    "2"};
     args.insert(args.end(), size.begin(), size.end());
     const auto start = std::chrono::steady_clock::now();
@@ -160,7 +160,7 @@ TEST_F(GoalCli, TimeLimitStopsByTheLimitWithThePlainRenderOfTheCountReached) {
     ASSERT_EQ(r.status, 0) << r.err;
     // The limit with 5 % over and a generous allowance for the process's start and end on a
     // loaded machine; and more than the pilots' 8 + 32 samples.
-    EXPECT_LT(wall, limit * 1.05 + 1.0) << r.err;
+    EXPECT_LT(wall, limit * 1.05 + 2.0) << r.err;
     const int spp = reached(r.err);
     EXPECT_GT(spp, 32) << r.err;
     std::vector<std::string> plain{"scene.xml", "--spp",     std::to_string(spp),
