@@ -85,6 +85,35 @@ constexpr std::uint32_t hash32(std::uint32_t x) {
     return x ^ (x >> 16);
 }
 
+// The grid of k points: m = floor(sqrt(k)) columns by n rows, m*n >= k, and the reciprocals the
+// points are scaled by. Tabulated for the counts that sets and pixels use, because the square
+// root and three divisions cost as much as a small set's points (docs/performance.md, fifth
+// round); a constant expression rounds each reciprocal exactly as the run-time division does.
+struct Shape {
+    std::uint32_t m = 1, n = 0;
+    double inv_cells = 0, inv_k = 0;
+};
+
+constexpr Shape shape_of(std::uint32_t k, std::uint32_t m) {
+    const std::uint32_t n = (k + m - 1) / m;
+    return {m, n, 1.0 / (double(m) * n), 1.0 / k};
+}
+
+constexpr std::uint32_t kTabledShapes = 512;
+constexpr std::array<Shape, kTabledShapes> kShapes = [] {
+    std::array<Shape, kTabledShapes> shapes{};
+    for (std::uint32_t k = 1, m = 1; k < kTabledShapes; ++k) {
+        if ((m + 1) * (m + 1) <= k) ++m;  // floor(sqrt(k))
+        shapes[k] = shape_of(k, m);
+    }
+    return shapes;
+}();
+
+Shape shape_for(std::uint32_t k) {
+    if (k > 0 && k < kTabledShapes) return kShapes[k];
+    return shape_of(k, std::max(1u, static_cast<std::uint32_t>(std::sqrt(double(k)))));  // floor
+}
+
 // The grid of a pattern of k points keyed by `key`, its shuffled columns and sub-columns, the
 // jitters' key and a set's rotation: what every point of the pattern shares.
 //
@@ -109,20 +138,17 @@ class Grid {
     std::vector<std::uint32_t> column_large_, sub_column_large_;
 
   public:
-    std::uint32_t m, n;
-    double inv_m, inv_cells, inv_k;
+    std::uint32_t k;
+    Shape shape;
     std::uint64_t jitter_key;
     std::uint32_t rotation;
     std::span<std::uint32_t> column, sub_column;
 
-    Grid(std::uint32_t k, std::uint32_t key)
-        : m(std::max(1u, static_cast<std::uint32_t>(std::sqrt(double(k))))),  // floor
-          n((k + m - 1) / m),
-          inv_m(1.0 / m),
-          inv_cells(1.0 / (double(m) * n)),
-          inv_k(1.0 / k),
-          column(side(column_small_, column_large_, m)),
-          sub_column(side(sub_column_small_, sub_column_large_, n)) {
+    Grid(std::uint32_t k_, std::uint32_t key)
+        : k(k_),
+          shape(shape_for(k_)),
+          column(side(column_small_, column_large_, shape.m)),
+          sub_column(side(sub_column_small_, sub_column_large_, shape.n)) {
         const std::uint64_t h = mix64(key ^ 0x7f4a7c159e3779b9ULL);
         jitter_key = mix64(h);
         Digits digits(static_cast<std::uint32_t>(h >> 32), h ^ 0x68bc21ebu);
@@ -130,41 +156,117 @@ class Grid {
             shuffle(column, digits);
             shuffle(sub_column, digits);
         } else {
-            for (std::uint32_t c = 0; c < m; ++c) column[c] = permute(c, m, key * 0x68bc21ebu);
-            for (std::uint32_t r = 0; r < n; ++r) sub_column[r] = permute(r, n, key * 0x02e5be93u);
+            for (std::uint32_t c = 0; c < shape.m; ++c) {
+                column[c] = permute(c, shape.m, key * 0x68bc21ebu);
+            }
+            for (std::uint32_t r = 0; r < shape.n; ++r) {
+                sub_column[r] = permute(r, shape.n, key * 0x02e5be93u);
+            }
         }
         rotation = k <= 4096 ? digits.below(k) : static_cast<std::uint32_t>(((h >> 32) * k) >> 32);
     }
     Grid(const Grid&) = delete;
     Grid& operator=(const Grid&) = delete;
+
+    // The cell of stratum s = row * m + col: column[col] * n + sub_column[row].
+    std::uint32_t cell(std::uint32_t s) const {
+        return column[s % shape.m] * shape.n + sub_column[s / shape.m];
+    }
 };
 
-// The points of strata strata[i] into out[i]: stratum s = row * m + col takes the cell
-// (column[col], sub_column[row]), x = (column[col] * n + sub_column[row] + jx) / (m n) and
+// Every stratum's cell, tabulated once for the points of a set or a run, so that their loop
+// looks up one table instead of two (and needs no division by m).
+class Cells {
+    static constexpr std::uint32_t kSmall = 1024;
+    std::array<std::uint32_t, kSmall> small_;
+    std::vector<std::uint32_t> large_;
+    std::uint32_t* cells_;
+
+  public:
+    explicit Cells(const Grid& grid) {
+        const std::uint32_t k = grid.k, m = grid.shape.m, n = grid.shape.n;
+        if (k > kSmall) large_.resize(k);
+        cells_ = k > kSmall ? large_.data() : small_.data();
+        for (std::uint32_t row = 0, s = 0; s < k; ++row) {
+            const std::uint32_t sub_column = grid.sub_column[row];
+            for (std::uint32_t col = 0; col < m && s < k; ++col, ++s) {
+                cells_[s] = grid.column[col] * n + sub_column;
+            }
+        }
+    }
+    Cells(const Cells&) = delete;
+    Cells& operator=(const Cells&) = delete;
+    const std::uint32_t* data() const { return cells_; }
+};
+
+// The point of stratum s in cell `cell` of the grid: x = (cell + jx) / (m n) and
 // y = (s + jy) / k. The jitters' 32 bits keep both below 1 for any k < 2^20, and the clamp
-// beyond. s / m is computed in floating point, exactly (the product is within 2^-51 n of
-// (s + 1/2) / m, whose distance to an integer is at least 1/(2m)), so that the loop vectorises;
-// the divisions by m n and k are products for the same reason.
-DRT_VECTORISED void grid_points(const Grid& grid, const std::uint32_t* strata, Vec2* out,
-                                std::size_t count) {
-    constexpr double kBelowOne = 0x1.fffffffffffffp-1;
-    const std::uint32_t* column = grid.column.data();
-    const std::uint32_t* sub_column = grid.sub_column.data();
-    const std::uint32_t m = grid.m, n = grid.n;
-    const double inv_m = grid.inv_m, inv_cells = grid.inv_cells, inv_k = grid.inv_k;
-    const auto key_x = static_cast<std::uint32_t>(grid.jitter_key),
-               key_y = static_cast<std::uint32_t>(grid.jitter_key >> 32);
-    for (std::size_t i = 0; i < count; ++i) {
-        const std::uint32_t s = strata[i];
-        const auto row = static_cast<std::uint32_t>(
-            static_cast<std::int32_t>((static_cast<double>(s) + 0.5) * inv_m));
-        const std::uint32_t cell = column[s - row * m] * n + sub_column[row];
+// beyond. The divisions are products so that loops of points vectorise.
+struct Jitter {
+    std::uint32_t key_x, key_y;
+    double inv_cells, inv_k;
+
+    explicit Jitter(const Grid& grid)
+        : key_x(static_cast<std::uint32_t>(grid.jitter_key)),
+          key_y(static_cast<std::uint32_t>(grid.jitter_key >> 32)),
+          inv_cells(grid.shape.inv_cells),
+          inv_k(grid.shape.inv_k) {}
+
+    Vec2 point(std::uint32_t s, std::uint32_t cell) const {
+        constexpr double kBelowOne = 0x1.fffffffffffffp-1;
         const std::uint32_t jx = hash32(s + key_x);
         const std::uint32_t jy = hash32(jx ^ key_y);
         const double x = (static_cast<double>(cell) + to_unit(jx)) * inv_cells;
         const double y = (static_cast<double>(s) + to_unit(jy)) * inv_k;
-        out[i] = {x < kBelowOne ? x : kBelowOne, y < kBelowOne ? y : kBelowOne};
+        return {x < kBelowOne ? x : kBelowOne, y < kBelowOne ? y : kBelowOne};
     }
+};
+
+// The points of strata strata[i] into out[i].
+DRT_VECTORISED void grid_points(const Jitter& jitter, const std::uint32_t* cells,
+                                const std::uint32_t* strata, Vec2* out, std::size_t count) {
+    for (std::size_t i = 0; i < count; ++i) out[i] = jitter.point(strata[i], cells[strata[i]]);
+}
+
+// Points of the strata start, start + 1, ... (count <= k, wrapping around once past k - 1) into
+// out.
+DRT_VECTORISED void rotated_points(const Jitter& jitter, const std::uint32_t* cells,
+                                   std::uint32_t start, std::uint32_t k, Vec2* out,
+                                   std::size_t count) {
+    for (std::size_t i = 0; i < count; ++i) {
+        std::uint32_t s = start + static_cast<std::uint32_t>(i);
+        s = s < k ? s : s - k;
+        out[i] = jitter.point(s, cells[s]);
+    }
+}
+
+// permute(first + i, n, key) into out[i]. Every label takes a step, and then those still outside
+// [0, n) another, pass after pass over all of them (the others left as they are) until none is:
+// the same walks as permute's, in loops that vectorise, where a walk per label would mispredict
+// its end about once per label (docs/performance.md, fifth round).
+DRT_VECTORISED void permute_run(std::uint32_t first, std::uint32_t n, std::uint32_t key,
+                                std::uint32_t* out, std::size_t count) {
+    if (n <= 1) {
+        std::fill_n(out, count, 0u);
+        return;
+    }
+    const std::uint32_t w = permute_mask(n);
+    std::uint32_t walking = 0;  // an integer: a bool's |= keeps the loop from vectorising
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::uint32_t x = permute_step(first + static_cast<std::uint32_t>(i), w, key);
+        out[i] = x;
+        walking |= static_cast<std::uint32_t>(x >= n);
+    }
+    while (walking != 0) {
+        walking = 0;
+        for (std::size_t i = 0; i < count; ++i) {
+            const std::uint32_t stepped = permute_step(out[i], w, key);
+            const std::uint32_t x = out[i] >= n ? stepped : out[i];
+            out[i] = x;
+            walking |= static_cast<std::uint32_t>(x >= n);
+        }
+    }
+    for (std::size_t i = 0; i < count; ++i) out[i] = permute_rotate(out[i], n, key);
 }
 
 // Labels are handled a batch at a time, so that a run of any length needs no allocation.
@@ -174,38 +276,36 @@ constexpr std::size_t kBatch = 256;
 
 void multi_jittered(std::uint32_t first, std::uint32_t k, std::uint32_t key, std::span<Vec2> out) {
     const Grid grid(k, key);
+    const Cells cells(grid);
+    const Jitter jitter(grid);
     const std::uint32_t stratum_key = key * 0x51633e2du;
     std::array<std::uint32_t, kBatch> strata;
     for (std::size_t done = 0; done < out.size(); done += kBatch) {
         const std::size_t count = std::min(kBatch, out.size() - done);
-        for (std::size_t i = 0; i < count; ++i) {
-            strata[i] = permute(first + static_cast<std::uint32_t>(done + i), k, stratum_key);
-        }
-        grid_points(grid, strata.data(), out.data() + done, count);
+        permute_run(first + static_cast<std::uint32_t>(done), k, stratum_key, strata.data(), count);
+        grid_points(jitter, cells.data(), strata.data(), out.data() + done, count);
     }
 }
 
 Vec2 multi_jittered(std::uint32_t j, std::uint32_t k, std::uint32_t key) {
-    Vec2 point;
-    multi_jittered(j, k, key, {&point, 1});
-    return point;
+    const Grid grid(k, key);
+    const std::uint32_t s = permute(j, k, key * 0x51633e2du);
+    return Jitter(grid).point(s, grid.cell(s));
 }
 
 void multi_jittered_set(std::uint32_t first, std::uint32_t k, std::uint32_t key,
                         std::span<Vec2> out) {
     const Grid grid(k, key);
-    std::array<std::uint32_t, kBatch> strata;
-    std::uint32_t start = (first % k + grid.rotation) % k;
-    // At most k labels at a time, so that the strata wrap around at most once.
-    const std::size_t most = std::min<std::size_t>(kBatch, k);
-    for (std::size_t done = 0; done < out.size(); done += most) {
-        const std::size_t count = std::min(most, out.size() - done);
-        for (std::size_t i = 0; i < count; ++i) {
-            const std::uint32_t s = start + static_cast<std::uint32_t>(i);
-            strata[i] = s < k ? s : s - k;
-        }
-        grid_points(grid, strata.data(), out.data() + done, count);
-        start = static_cast<std::uint32_t>((start + count) % k);
+    const Cells cells(grid);
+    const Jitter jitter(grid);
+    // At most k points at a time, so that the strata wrap around at most once. (Sets are drawn
+    // at every shading point: the remainders are taken only when they can differ from a compare.)
+    for (std::size_t done = 0; done < out.size(); done += k) {
+        const std::uint32_t at = first + static_cast<std::uint32_t>(done);
+        std::uint32_t start = (at < k ? at : at % k) + grid.rotation;
+        if (start >= k) start -= k;
+        rotated_points(jitter, cells.data(), start, k, out.data() + done,
+                       std::min<std::size_t>(k, out.size() - done));
     }
 }
 

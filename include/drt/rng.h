@@ -36,40 +36,56 @@ constexpr double to_unit(std::uint32_t word) {
     return static_cast<double>(word) * 0x1.0p-32;
 }
 
+// One step of permute's cycle walk: a keyed bijection of [0, w] for w = 2^b - 1.
+constexpr std::uint32_t permute_step(std::uint32_t i, std::uint32_t w, std::uint32_t key) {
+    // Xor with a constant, multiplication by an odd number and xor with a right shift of the
+    // masked bits all leave the low bits a bijection of the low bits.
+    i ^= key;
+    i *= 0xe170893du;
+    i ^= key >> 16;
+    i ^= (i & w) >> 4;
+    i ^= key >> 8;
+    i *= 0x0929eb3fu;
+    i ^= key >> 23;
+    i ^= (i & w) >> 1;
+    i *= 1u | key >> 27;
+    i *= 0x6935fa69u;
+    i ^= (i & w) >> 11;
+    i *= 0x74dcb303u;
+    i ^= (i & w) >> 2;
+    i *= 0x9e501cc3u;
+    i ^= (i & w) >> 2;
+    i *= 0xc860a3dfu;
+    i &= w;
+    i ^= i >> 5;
+    return i;
+}
+
+// The smallest 2^b - 1 >= n - 1: the domain permute_step walks for a permutation of [0, n).
+constexpr std::uint32_t permute_mask(std::uint32_t n) {
+    std::uint32_t w = n - 1;
+    w |= w >> 1, w |= w >> 2, w |= w >> 4, w |= w >> 8, w |= w >> 16;
+    return w;
+}
+
+// The rotation by the key that ends permute, (i + key) mod n for i < n, in 64 bits: Kensler's
+// 32-bit (i + key) % n wraps for large keys and maps two elements to one.
+constexpr std::uint32_t permute_rotate(std::uint32_t i, std::uint32_t n, std::uint32_t key) {
+    const std::uint64_t r = std::uint64_t{i} + key % n;
+    return static_cast<std::uint32_t>(r >= n ? r - n : r);
+}
+
 // A pseudo-random permutation of [0, n) evaluated at i: Kensler's function from "Correlated
 // Multi-Jittered Sampling" (2013), which cycle-walks a keyed bijection on the smallest
 // power-of-two domain that holds n. Each step is invertible on the low bits, and every key bit
 // takes part, so over random keys each element is sent to every position equally often.
 constexpr std::uint32_t permute(std::uint32_t i, std::uint32_t n, std::uint32_t key) {
     if (n <= 1) return 0;
-    std::uint32_t w = n - 1;  // the smallest 2^b - 1 >= n - 1
-    w |= w >> 1, w |= w >> 2, w |= w >> 4, w |= w >> 8, w |= w >> 16;
+    const std::uint32_t w = permute_mask(n);
     do {
-        // Xor with a constant, multiplication by an odd number and xor with a right shift of the
-        // masked bits all leave the low bits a bijection of the low bits.
-        i ^= key;
-        i *= 0xe170893du;
-        i ^= key >> 16;
-        i ^= (i & w) >> 4;
-        i ^= key >> 8;
-        i *= 0x0929eb3fu;
-        i ^= key >> 23;
-        i ^= (i & w) >> 1;
-        i *= 1u | key >> 27;
-        i *= 0x6935fa69u;
-        i ^= (i & w) >> 11;
-        i *= 0x74dcb303u;
-        i ^= (i & w) >> 2;
-        i *= 0x9e501cc3u;
-        i ^= (i & w) >> 2;
-        i *= 0xc860a3dfu;
-        i &= w;
-        i ^= i >> 5;
+        i = permute_step(i, w, key);
     } while (i >= n);
-    // The final rotation by the key, in 64 bits: Kensler's 32-bit (i + key) % n wraps for large
-    // keys and maps two elements to one.
-    const std::uint64_t r = std::uint64_t{i} + key % n;
-    return static_cast<std::uint32_t>(r >= n ? r - n : r);
+    return permute_rotate(i, n, key);
 }
 
 }  // namespace drt
