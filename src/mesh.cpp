@@ -591,21 +591,26 @@ std::optional<Hit> Mesh::intersect(const Ray& ray, Interval range) const {
     return Hit{hit->t, this, hit->triangle, {hit->b.b1, hit->b.b2}};
 }
 
-Object::SurfacePoint Mesh::locate(const Ray& ray, const Hit& hit) const {
+Object::SurfaceCoordinates Mesh::locate(const Ray& ray, const Hit& hit, SurfaceHit& surface) const {
     const Vec3 origin = path_.at(ray.time);
     const auto [a, b, c] = mesh_->corners(hit.primitive);
     const Barycentrics w{1 - hit.uv.x - hit.uv.y, hit.uv.x, hit.uv.y};
     // From the barycentrics rather than ray.at(t): on the triangle's plane to rounding in the
     // mesh's own coordinates, whatever distance the ray came from.
-    const Vec3 point = origin + (a * w.b0 + b * w.b1 + c * w.b2);
-    const Vec3 normal = mesh_->geometric_normal(hit.primitive);
+    surface.point = origin + (a * w.b0 + b * w.b1 + c * w.b2);
+    surface.normal = mesh_->geometric_normal(hit.primitive);
+    surface.shading_normal = mesh_->shading_normal(hit.primitive, w);
+    if (mesh_->smooth()) {
+        surface.light_point = origin + mesh_->lifted(hit.primitive, w);
+        surface.light_normal = surface.shading_normal;
+    } else {
+        surface.light_point = surface.point;
+        surface.light_normal = surface.normal;
+    }
     // Textures and bumps stay where the mesh is at time 0, the present: world coordinates for
     // a mesh that does not move.
-    const Vec3 fixed = point - (origin - path_.at(0));
-    const Vec3 shading = mesh_->shading_normal(hit.primitive, w);
-    if (!mesh_->smooth()) return {point, normal, shading, fixed, fixed};
-    return {point, normal, shading,
-            fixed, fixed,  LightStart{origin + mesh_->lifted(hit.primitive, w), shading}};
+    const Vec3 fixed = surface.point - (origin - path_.at(0));
+    return {fixed, fixed};
 }
 
 }  // namespace drt

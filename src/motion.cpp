@@ -6,8 +6,7 @@ namespace drt {
 
 MotionPath::MotionPath(std::vector<Vec3> points) : points_(std::move(points)) {}
 
-Vec3 MotionPath::at(double time) const {
-    if (points_.size() == 1 || time <= 0) return points_.front();
+Vec3 MotionPath::moving_at(double time) const {
     if (time >= end()) return points_.back();
     return segment(static_cast<std::size_t>(time)).at(time);
 }

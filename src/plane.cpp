@@ -33,10 +33,13 @@ std::optional<Hit> Plane::intersect(const Ray& ray, Interval range) const {
     return Hit{*t, this, 0, {}};
 }
 
-Object::SurfacePoint Plane::locate(const Ray& ray, const Hit& hit) const {
+Object::SurfaceCoordinates Plane::locate(const Ray& ray, const Hit& hit,
+                                         SurfaceHit& surface) const {
     const Vec3 p = ray.at(hit.t);
     const Vec3 point = p - frame_.n * (dot(p, frame_.n) - offset_);
-    return {point, frame_.n, frame_.n, {dot(point, frame_.t), dot(point, frame_.b), 0}, point};
+    surface.point = surface.light_point = point;
+    surface.normal = surface.shading_normal = surface.light_normal = frame_.n;
+    return {{dot(point, frame_.t), dot(point, frame_.b), 0}, point};
 }
 
 }  // namespace drt

@@ -14,12 +14,15 @@ std::optional<Hit> Sphere::intersect(const Ray& ray, Interval range) const {
     return Hit{*t, this, 0, {}};
 }
 
-Object::SurfacePoint Sphere::locate(const Ray& ray, const Hit& hit) const {
+Object::SurfaceCoordinates Sphere::locate(const Ray& ray, const Hit& hit,
+                                          SurfaceHit& surface) const {
     const Vec3 c = path_.at(ray.time);
     const Vec3 point = c + normalize(ray.at(hit.t) - c) * radius_;
     const Vec3 normal = normalize(point - c);
+    surface.point = surface.light_point = point;
+    surface.normal = surface.shading_normal = surface.light_normal = normal;
     // Textures and bumps move with the sphere.
-    return {point, normal, normal, point - c, point - c};
+    return {point - c, point - c};
 }
 
 }  // namespace drt

@@ -74,7 +74,7 @@ class TriangleMesh {
     Vec3 shading_normal(std::uint32_t triangle, const Barycentrics& b) const;
     bool smooth() const { return !normals_.empty(); }
     // For a smooth mesh, the point at `b` moved out onto the curved surface that the vertex
-    // normals describe (LightStart in object.h).
+    // normals describe (SurfaceHit::light_point in object.h).
     Vec3 lifted(std::uint32_t triangle, const Barycentrics& b) const;
 
     // Memory held for geometry and hierarchy.
@@ -153,7 +153,7 @@ class Mesh final : public Object {
     const MotionPath& path() const { return path_; }
 
   protected:
-    SurfacePoint locate(const Ray& ray, const Hit& hit) const override;
+    SurfaceCoordinates locate(const Ray& ray, const Hit& hit, SurfaceHit& surface) const override;
 
   private:
     std::shared_ptr<const TriangleMesh> mesh_;

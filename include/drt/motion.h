@@ -30,7 +30,11 @@ class MotionPath {
   public:
     explicit MotionPath(std::vector<Vec3> points);
 
-    Vec3 at(double time) const;
+    // Inline for the common still path: every hit on a sphere asks where its centre is.
+    Vec3 at(double time) const {
+        if (points_.size() == 1 || time <= 0) return points_.front();
+        return moving_at(time);
+    }
     // Time at which the path ends; 0 for a path that stays put.
     double end() const { return static_cast<double>(points_.size() - 1); }
     bool moves() const { return points_.size() > 1; }
@@ -46,6 +50,8 @@ class MotionPath {
     const std::vector<Vec3>& points() const { return points_; }
 
   private:
+    Vec3 moving_at(double time) const;
+
     std::vector<Vec3> points_;
 };
 

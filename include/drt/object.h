@@ -40,17 +40,13 @@ struct SurfaceHit {
     Vec3 shading_normal;  // normal after bump mapping, same side as `normal`
     Color kd;             // diffuse colour after texturing
     // Where shadow rays leave, and the normal that says which lights are above the surface:
-    // `point` and `normal`, except on a smooth mesh (LightStart).
+    // `point` and `normal`, except on a smooth mesh. There the lights a shading normal sees may
+    // be below the flat facet, and shadow rays from the facet would meet the facet's neighbours:
+    // black facets along the shadow terminator. Shadow rays leave instead from the point lifted
+    // onto the curved surface the vertex normals describe (Hanika, "Hacking the shadow
+    // terminator", Ray Tracing Gems II, 2021), and the interpolated normal decides which lights
+    // are above.
     Vec3 light_point, light_normal;
-};
-
-// On a mesh with interpolated normals, the lights a shading normal sees may be below the flat
-// facet, and shadow rays from the facet would meet the facet's neighbours: black facets along
-// the shadow terminator. Shadow rays leave instead from the point lifted onto the curved surface
-// the vertex normals describe (Hanika, "Hacking the shadow terminator", Ray Tracing Gems II,
-// 2021), and the interpolated normal decides which lights are above.
-struct LightStart {
-    Vec3 point, normal;
 };
 
 // A sphere as the BVH stores it: the BVH splits its path into one piece per segment, each bounded
@@ -108,20 +104,19 @@ class Object {
     SurfaceHit surface_at(const Ray& ray, const Hit& hit) const;
 
   protected:
-    // Where on the surface a hit lies, before texture and bump.
-    struct SurfacePoint {
-        // The exact point on the surface nearest to ray.at(t), which removes most of the
-        // rounding error a hit point picks up.
-        Vec3 point;
-        Vec3 normal;  // geometric, unit, outward
-        // Before bump mapping: the geometric normal, or one a mesh interpolates over a triangle.
-        Vec3 shading_normal;
-        // Coordinates a texture is evaluated in (fixed to a moving object), and world-aligned
-        // ones for bump noise.
+    // Where a texture and a bump map are evaluated at a hit: coordinates fixed to a moving
+    // object for the texture, world-aligned ones for bump noise.
+    struct SurfaceCoordinates {
         Vec3 texture_point, bump_point;
-        std::optional<LightStart> light_start = {};  // absent: from point, by normal
     };
-    virtual SurfacePoint locate(const Ray& ray, const Hit& hit) const = 0;
+    // Where on the surface a hit lies, before texture and bump, written into `surface`: the
+    // exact point on the surface nearest to ray.at(t) (which removes most of the rounding error
+    // a hit point picks up), the geometric normal (unit, outward), the shading normal before
+    // bump mapping (the geometric one, or one a mesh interpolates over a triangle), and where
+    // shadow rays leave. Written in place rather than returned: copying a returned record cost
+    // 2 % of a render in stalled loads (docs/performance.md, fifth round).
+    virtual SurfaceCoordinates locate(const Ray& ray, const Hit& hit,
+                                      SurfaceHit& surface) const = 0;
 
   private:
     const Material* material_;

@@ -42,7 +42,7 @@ class Plane final : public Object {
   protected:
     // Textures are evaluated in the plane's own 2-D coordinates (about the world origin's
     // projection), so a checker on a plane through the origin has a cell corner there.
-    SurfacePoint locate(const Ray& ray, const Hit& hit) const override;
+    SurfaceCoordinates locate(const Ray& ray, const Hit& hit, SurfaceHit& surface) const override;
 
   private:
     Vec3 point_;

@@ -24,7 +24,7 @@ class Sphere final : public Object {
     const MotionPath& path() const { return path_; }
 
   protected:
-    SurfacePoint locate(const Ray& ray, const Hit& hit) const override;
+    SurfaceCoordinates locate(const Ray& ray, const Hit& hit, SurfaceHit& surface) const override;
 
   private:
     MotionPath path_;
