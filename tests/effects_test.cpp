@@ -335,32 +335,71 @@ TEST(Effects, ThinLensBlurWidthIsTheCircleOfConfusionToAPercent) {
                 0.01 * circle_of_confusion(depth));
 }
 
+// What column x of an image of the edge shows when blurred over a circle of confusion `coc`:
+// the edge projects onto the boundary between pixels 23 and 24, and a film point u pixels right
+// of it sees white through the part of the lens disk on one side of a line u / (coc/2) radii off
+// centre; a pixel averages that over its width (box filter).
+double edge_profile(int x, double coc) {
+    const double left = x - kLensWidth / 2.0;
+    double expected = 0;
+    constexpr int kSteps = 1000;
+    for (int i = 0; i < kSteps; ++i) {
+        expected += disk_fraction((left + (i + 0.5) / kSteps) / (coc / 2)) / kSteps;
+    }
+    return expected;
+}
+
+// The circle of confusion whose profile fits the columns best (least squares), searched within
+// a fifth of `guess`.
+double fitted_coc(const std::vector<double>& columns, double guess) {
+    const auto misfit = [&](double coc) {
+        double sum = 0;
+        for (int x = 0; x < kLensWidth; ++x) {
+            const double d = columns[static_cast<std::size_t>(x)] - edge_profile(x, coc);
+            sum += d * d;
+        }
+        return sum;
+    };
+    double lo = 0.8 * guess, hi = 1.2 * guess;
+    for (int i = 0; i < 60; ++i) {  // golden-section search
+        const double a = hi - (hi - lo) * 0.6180339887, b = lo + (hi - lo) * 0.6180339887;
+        if (misfit(a) < misfit(b)) {
+            hi = b;
+        } else {
+            lo = a;
+        }
+    }
+    return (lo + hi) / 2;
+}
+
 TEST(Effects, ThinLensBlursAnEdgeOverTheCircleOfConfusion) {
+    // Measured over seeds 0-10 (256 samples a pixel): a pixel strays from the profile by at most
+    // 0.026 and a column's mean over the 3 rows by 0.014, the circle fitted to the columns by
+    // 1.0 % at one depth and 0.52 % on average over the three; with the lens radius 2 % too
+    // large the average is off by 1.4 % to 2.4 %. So the pixels and columns catch gross errors
+    // with room to spare over any seed, and the average fit catches a 2 % radius.
+    double fit_error = 0;
     for (const double depth : {150.0, 60.0, 250.0}) {
         SCOPED_TRACE(depth);
         const double coc = circle_of_confusion(depth);
         const RenderResult r = render_with(edge_scene(depth, kLensRadius));
-        // The edge projects onto the boundary between pixels 23 and 24. A film point u pixels
-        // right of it sees white through the part of the lens disk on one side of a line u /
-        // (coc/2) radii off centre; a pixel averages that over its width (box filter).
         std::vector<double> columns;
         for (int x = 0; x < kLensWidth; ++x) {
-            const double left = x - kLensWidth / 2.0;
-            double expected = 0;
-            constexpr int kSteps = 1000;
-            for (int i = 0; i < kSteps; ++i) {
-                expected += disk_fraction((left + (i + 0.5) / kSteps) / (coc / 2)) / kSteps;
-            }
+            const double expected = edge_profile(x, coc);
             double column = 0;
             for (int y = 0; y < kLensHeight; ++y) {
-                ASSERT_NEAR(r.image.at(x, y).r, expected, 0.03) << x << "," << y;
+                ASSERT_NEAR(r.image.at(x, y).r, expected, 0.06) << x << "," << y;
                 column += r.image.at(x, y).r / kLensHeight;
             }
+            EXPECT_NEAR(column, expected, 0.03) << x;
             columns.push_back(column);
         }
         EXPECT_NEAR(blur_diameter(columns), coc, 0.03 * coc) << "coc " << coc;
+        EXPECT_NEAR(fitted_coc(columns, coc), coc, 0.03 * coc) << "coc " << coc;
+        fit_error += (fitted_coc(columns, coc) / coc - 1) / 3;
         EXPECT_GT(coc, 7);
     }
+    EXPECT_NEAR(fit_error, 0, 0.01);
     // In the focal plane the edge stays sharp, and a pinhole is sharp at any depth.
     for (const auto& [depth, radius] : {std::pair{kFocal, kLensRadius}, std::pair{60.0, 0.0}}) {
         const RenderResult r = render_with(edge_scene(depth, radius));
