@@ -177,7 +177,14 @@ TEST_F(ExrTest, TruncatedOrCorruptFilesThrowImageErrors) {
     const auto decode = [&](const std::string& data) {
         decode_exr(std::vector<unsigned char>(data.begin(), data.end()), bad);
     };
-    for (std::size_t keep = 0; keep < bytes.size(); ++keep) {
+#if defined(__SANITIZE_ADDRESS__)
+    // Under ASan a variant costs ~30 ms (it clears the shadow of the large tables OpenEXR
+    // allocates from a corrupt header): the sanitizer build tries every 7th, Release all of them.
+    constexpr std::size_t kEvery = 7;
+#else
+    constexpr std::size_t kEvery = 1;
+#endif
+    for (std::size_t keep = 0; keep < bytes.size(); keep += kEvery) {
         SCOPED_TRACE("cut to " + std::to_string(keep) + " of " + std::to_string(bytes.size()));
         try {
             decode(bytes.substr(0, keep));
@@ -190,7 +197,7 @@ TEST_F(ExrTest, TruncatedOrCorruptFilesThrowImageErrors) {
     // that break sizes, types and offsets. Some changes leave a readable image (a pixel value
     // changes); none may escape as anything but an ImageError.
     int refused = 0;
-    for (std::size_t i = 0; i < bytes.size(); i += i < 400 ? 1 : 37) {
+    for (std::size_t i = 0; i < bytes.size(); i += i < 400 ? kEvery : 37) {
         for (const unsigned char v : {0x00, 0x7f, 0xff}) {
             std::string changed = bytes;
             changed[i] = static_cast<char>(v);
@@ -201,7 +208,7 @@ TEST_F(ExrTest, TruncatedOrCorruptFilesThrowImageErrors) {
             }
         }
     }
-    EXPECT_GT(refused, 50);
+    EXPECT_GT(refused, 50 / static_cast<int>(kEvery));
     // Through the file reader too: a cut file and garbage.
     for (const std::string& garbage :
          {bytes.substr(0, bytes.size() / 2), std::string("v/1\x01"), std::string(100, '\0'),
