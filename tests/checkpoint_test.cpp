@@ -16,6 +16,7 @@
 #include "drt/render_job.h"
 #include "drt/scene_loader.h"
 #include "run_drt.h"
+#include "temp_folder.h"
 
 namespace drt {
 namespace {
@@ -35,20 +36,7 @@ Scene small_scene(const fs::path& file = kEffects) {
     return std::move(loaded.scene);
 }
 
-class TempDir : public ::testing::Test {
-  protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() /
-               ("drt_checkpoint_test_" + std::to_string(getpid()) + "_" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override {
-        if (!HasFailure()) fs::remove_all(dir_);
-    }
-    fs::path dir_;
-};
+using TempDir = TempFolderTest;
 
 TileBuffer some_tile(const Tile& tile, float base) {
     TileBuffer t;

@@ -16,6 +16,7 @@
 #include "drt/converge.h"
 #include "drt/image.h"
 #include "run_drt.h"
+#include "temp_folder.h"
 
 namespace drt {
 namespace {
@@ -80,18 +81,11 @@ constexpr const char* kScene = R"(<?xml version="1.0"?>
 </Scene>
 )";
 
-class GoalCli : public ::testing::Test {
+class GoalCli : public test::TempFolderTest {
   protected:
     void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() /
-               ("drt_goal_test_" + std::to_string(getpid()) + "_" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
+        TempFolderTest::SetUp();
         test::write_bytes(dir_ / "scene.xml", kScene);
-    }
-    void TearDown() override {
-        if (!HasFailure()) fs::remove_all(dir_);
     }
     Outcome run(const std::vector<std::string>& args) const { return run_drt(args, dir_); }
     std::string bytes(const std::string& name) const { return read_bytes(dir_ / name); }
@@ -101,8 +95,6 @@ class GoalCli : public ::testing::Test {
         const std::regex spp(": --spp (\\d+) renders the same image");
         return std::regex_search(err, m, spp) ? std::stoi(m[1]) : -1;
     }
-
-    fs::path dir_;
 };
 
 TEST_F(GoalCli, BadGoalsExitTwoWithTheReasonAndWriteNothing) {

@@ -1,4 +1,5 @@
-// A fresh, empty folder per test, named after it and removed afterwards.
+// A fresh, empty folder per test, named after it; removed afterwards unless the test failed, so
+// that what a failing test wrote can be looked at.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -19,7 +20,9 @@ class TempFolderTest : public ::testing::Test {
         std::filesystem::remove_all(dir_);
         std::filesystem::create_directories(dir_);
     }
-    void TearDown() override { std::filesystem::remove_all(dir_); }
+    void TearDown() override {
+        if (!HasFailure()) std::filesystem::remove_all(dir_);
+    }
 
     std::filesystem::path dir_;
 };
