@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 #include <poll.h>
 #include <pty.h>
-#include <regex.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -24,25 +23,11 @@
 #include <vector>
 
 #include "drt/image.h"
+#include "regex_match.h"
 #include "run_drt.h"
 
 namespace drt {
 namespace {
-
-// The length of the leftmost match of a POSIX extended regular expression in `text`, or -1.
-// (libc's regex rather than std::regex, whose GCC 12 templates warn under the sanitizers.)
-long regex_match_length(const std::string& text, const char* pattern) {
-    regex_t compiled;
-    if (regcomp(&compiled, pattern, REG_EXTENDED) != 0) throw std::invalid_argument(pattern);
-    regmatch_t match;
-    const bool found = regexec(&compiled, text.c_str(), 1, &match, 0) == 0;
-    regfree(&compiled);
-    return found ? static_cast<long>(match.rm_eo - match.rm_so) : -1;
-}
-
-bool regex_search(const std::string& text, const char* pattern) {
-    return regex_match_length(text, pattern) >= 0;
-}
 
 namespace fs = std::filesystem;
 using namespace test;

@@ -9,12 +9,12 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <regex>
 #include <string>
 #include <vector>
 
 #include "drt/converge.h"
 #include "drt/image.h"
+#include "regex_match.h"
 #include "run_drt.h"
 #include "temp_folder.h"
 
@@ -23,6 +23,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using test::Outcome;
+using test::regex_groups;
 using test::read_bytes;
 using test::run_drt;
 
@@ -91,9 +92,8 @@ class GoalCli : public test::TempFolderTest {
     std::string bytes(const std::string& name) const { return read_bytes(dir_ / name); }
     // N of the "--spp N renders the same image" line.
     static int reached(const std::string& err) {
-        std::smatch m;
-        const std::regex spp(": --spp (\\d+) renders the same image");
-        return std::regex_search(err, m, spp) ? std::stoi(m[1]) : -1;
+        const auto groups = regex_groups(err, ": --spp ([0-9]+) renders the same image");
+        return groups.empty() ? -1 : std::stoi(groups[1]);
     }
 };
 
@@ -199,11 +199,13 @@ TEST_F(GoalCli, TargetErrorGivesTheSameBitsForAnyThreadCount) {
 TEST_F(GoalCli, InfoPredictsTheSamplesAndTimeFromPilots) {
     const Outcome r = run({"info", "scene.xml", "--target-error", "0.005"});
     ASSERT_EQ(r.status, 0) << r.err;
-    const std::regex line(
+    const auto groups = regex_groups(
+        r.out,
         "\npilots: 8 spp [0-9.]+ s, estimated rmse [0-9.e-]+; 32 spp [0-9.]+ s, estimated rmse "
         "[0-9.e-]+;\npredicted for --target-error 0.005: ([0-9]+) spp, [0-9.]+ s on this machine "
-        "\\(--spp \\1 alone: [0-9.]+ s\\)\n$");
-    EXPECT_TRUE(std::regex_search(r.out, line)) << r.out;
+        "\\(--spp ([0-9]+) alone: [0-9.]+ s\\)\n$");
+    ASSERT_EQ(groups.size(), 3u) << r.out;
+    EXPECT_EQ(groups[1], groups[2]) << r.out;
     const Outcome bad = run({"info", "scene.xml", "--target-error", "0"});
     EXPECT_EQ(bad.status, 2);
     EXPECT_EQ(bad.err,
