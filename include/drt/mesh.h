@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "drt/math.h"
+#include "drt/mesh_build.h"
 #include "drt/motion.h"
 #include "drt/obj_reader.h"
 #include "drt/object.h"
@@ -90,14 +91,6 @@ class TriangleMesh {
     std::span<const std::byte> hierarchy() const { return std::as_bytes(std::span(nodes_)); }
 
   private:
-    // The build's binary tree, 32 bytes a node: its box, and either its triangles (a leaf:
-    // `count` of them from `offset`) or its second child (an inner node: `count` 0, the first
-    // child follows it).
-    struct BinaryNode {
-        Float3 lo, hi;
-        std::uint32_t offset;
-        std::uint32_t count;
-    };
     // The tree traversed has up to four children a node, their boxes side by side so that one
     // 4-wide SIMD test tests them all (Wald, Benthin & Boulos 2008; Dammertz et al. 2008):
     // 128 bytes a node. A child is a node (`count` 0, `child` its index) or a leaf (`count`
@@ -109,16 +102,9 @@ class TriangleMesh {
         std::uint32_t children;
         std::uint32_t unused;  // 0: a node has no padding bytes of unknown value
     };
-    struct BuildItem;
 
     Vec3 position(std::uint32_t vertex) const;
     void build_hierarchy(int threads);
-    // Builds the subtree of items [begin, end) into `nodes` (its root at the end of `nodes`,
-    // node indices relative to the start of `nodes`); `tasks` > 1 builds second subtrees on
-    // threads of their own, that many at a time at most.
-    static std::uint32_t build(std::vector<BuildItem>& items, std::uint32_t begin,
-                               std::uint32_t end, int depth, std::vector<BinaryNode>& nodes,
-                               int tasks);
     // Turns the binary subtree at `node` into 4-wide nodes appended to nodes_; returns the index
     // of the one made for `node`.
     std::uint32_t widen(const std::vector<BinaryNode>& binary, std::uint32_t node);
