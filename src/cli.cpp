@@ -939,7 +939,8 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
     return status;
 }
 
-// Pilot rounds (progressive.h) of `scene` and what they predict for reaching `target`.
+// The pilot rounds a render of `scene` to `target` takes (progressive.h) and what they predict
+// for its final round.
 struct GoalForecast {
     std::vector<ProgressiveRound> pilots;
     std::optional<Prediction> prediction;
@@ -948,16 +949,19 @@ struct GoalForecast {
 GoalForecast forecast(Scene& scene, double target, int threads) {
     ProgressiveGoal goal;
     goal.target_error = target;
-    goal.max_samples = kPilotSamples[std::size(kPilotSamples) - 1];
+    goal.max_samples = kMaxSamples;
+    goal.pilots_only = true;
     RenderJobOptions options;
     options.threads = threads;
     GoalForecast f;
     const ProgressiveResult pilots = render_progressively(scene, options, goal);
     f.pilots = pilots.rounds;
-    if (pilots.target_met) {
+    if (pilots.rounds.empty()) return f;
+    const NextRound last = next_round(pilots.rounds, target, kMaxSamples);
+    if (last.spp == 0) {
         f.prediction = Prediction{pilots.samples, pilots.rounds.back().seconds};
-    } else {
-        f.prediction = predict(pilots.rounds, target, kMaxSamples);
+    } else if (last.final) {
+        f.prediction = Prediction{last.spp, predicted_seconds(pilots.rounds, last.spp)};
     }
     return f;
 }

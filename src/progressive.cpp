@@ -14,10 +14,14 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// A round's count at most this many times the last one's: an extrapolation from a pilot a
-// hundred times smaller is too uncertain to bet the whole budget on, and a round a sixteenth of
-// the next costs little.
+// Under a time budget, a round's count at most this many times the last one's: an
+// extrapolation from a round a hundred times smaller is too uncertain to bet the whole budget
+// on, and a round a sixteenth of the next costs little.
 constexpr double kMaxGrowth = 16;
+// A pilot at least this many times the last round's count: a narrower span measures no slope.
+constexpr int kMinPilotGrowth = 3;
+// The error's log-log slope against samples for independent samples.
+constexpr double kIndependentSlope = -0.5;
 // Of the time left, what a round may be predicted to take: the rest absorbs the prediction's
 // error.
 constexpr double kTimeShare = 0.9;
@@ -78,16 +82,34 @@ std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, d
     for (const ProgressiveRound& r : rounds) {
         if (r.error && *r.error > 0 && std::isfinite(*r.error)) measured.push_back(&r);
     }
-    if (measured.size() < 2) return std::nullopt;
-    const ProgressiveRound& a = *measured[measured.size() - 2];
+    if (measured.empty()) return std::nullopt;
     const ProgressiveRound& b = *measured.back();
-    if (a.spp == b.spp) return std::nullopt;
-    const double slope =
-        std::clamp(std::log(*b.error / *a.error) / std::log(double(b.spp) / a.spp), -1.0, -0.25);
+    double slope = kIndependentSlope;
+    if (measured.size() >= 2) {
+        const ProgressiveRound& a = *measured[measured.size() - 2];
+        if (a.spp == b.spp) return std::nullopt;
+        slope = std::clamp(std::log(*b.error / *a.error) / std::log(double(b.spp) / a.spp), -1.0,
+                           -0.25);
+    }
     double spp = b.spp;
     if (*b.error > target) spp = b.spp * std::pow(target / *b.error, 1 / slope) * kSpare;
     const int count = static_cast<int>(std::clamp(std::ceil(spp), 1.0, double(max_samples)));
     return Prediction{count, predicted_seconds(rounds, count)};
+}
+
+NextRound next_round(const std::vector<ProgressiveRound>& rounds, double target, int max_samples) {
+    const ProgressiveRound& last = rounds.back();
+    if ((last.error && *last.error <= target) || last.spp >= max_samples) return {};
+    const auto p = predict(rounds, target, max_samples);
+    NextRound next{p ? p->spp : kMinPilotGrowth * last.spp, p.has_value()};
+    if (next.spp > kFinalStep * last.spp) {
+        next = {std::max((next.spp + kFinalStep - 1) / kFinalStep, kMinPilotGrowth * last.spp),
+                false};
+    }
+    // At least a quarter more, or the round is not worth its time.
+    next.spp = std::max<double>(next.spp, std::ceil(1.25 * last.spp));
+    next.spp = static_cast<int>(std::min<double>(next.spp, max_samples));
+    return next;
 }
 
 ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& options,
@@ -98,7 +120,7 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
         return *goal.time_limit - std::chrono::duration<double>(Clock::now() - goal.start).count();
     };
     ProgressiveResult out;
-    int spp = std::min(kPilotSamples[0], goal.max_samples);
+    int spp = std::min(kFirstPilot, goal.max_samples);
     for (std::size_t round = 0; spp > 0; ++round) {
         scene.settings.samples = spp;
         // Dropped when the budget runs out before it is done, except the first: without it
@@ -118,39 +140,27 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
         int next = 0;
         if (!leader) {
             out.job = std::move(job);
+        } else if (!job.complete()) {
+            out.stopped = options.stop.stop_requested();
+            if (out.rounds.empty()) out.job = std::move(job);
         } else {
-            if (!job.complete()) {
-                out.stopped = options.stop.stop_requested();
-                if (out.rounds.empty()) out.job = std::move(job);
-            } else {
-                const ProgressiveRound done{spp, job.render.stats.seconds,
-                                            estimated_error(job.render)};
-                out.rounds.push_back(done);
-                out.job = std::move(job);
-                out.samples = spp;
-                out.error = done.error;
-                out.target_met =
-                    goal.target_error && done.error && *done.error <= *goal.target_error;
-                if (!out.target_met && spp < goal.max_samples) {
-                    if (round + 1 < std::size(kPilotSamples)) {
-                        next = kPilotSamples[round + 1];
-                    } else if (goal.target_error) {
-                        const auto p = predict(out.rounds, *goal.target_error, goal.max_samples);
-                        next = p ? p->spp : 4 * spp;
-                    } else {
-                        next = goal.max_samples;
-                    }
-                    // At least a quarter more, or the round is not worth its time.
-                    next = std::max<double>(next, std::ceil(1.25 * spp));
-                    next = static_cast<int>(
-                        std::min({double(next), kMaxGrowth * spp, double(goal.max_samples)}));
-                    if (goal.time_limit) {
-                        const Line line = time_line(out.rounds);
-                        const double fits = std::floor((kTimeShare * seconds_left() - line.setup) /
-                                                       line.per_sample);
-                        if (fits < next) next = fits >= 1.25 * spp ? static_cast<int>(fits) : 0;
-                    }
-                }
+            const ProgressiveRound done{spp, job.render.stats.seconds, estimated_error(job.render)};
+            out.rounds.push_back(done);
+            out.job = std::move(job);
+            out.samples = spp;
+            out.error = done.error;
+            out.target_met = goal.target_error && done.error && *done.error <= *goal.target_error;
+            if (goal.target_error) {
+                const NextRound n = next_round(out.rounds, *goal.target_error, goal.max_samples);
+                next = n.final && goal.pilots_only ? 0 : n.spp;
+            } else if (spp < goal.max_samples) {
+                next = static_cast<int>(std::min(kMaxGrowth * spp, double(goal.max_samples)));
+            }
+            if (goal.time_limit && next > 0) {
+                const Line line = time_line(out.rounds);
+                const double fits =
+                    std::floor((kTimeShare * seconds_left() - line.setup) / line.per_sample);
+                if (fits < next) next = fits >= 1.25 * spp ? static_cast<int>(fits) : 0;
             }
         }
         spp = options.mpi ? options.mpi->leaders(next) : next;

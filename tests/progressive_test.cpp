@@ -23,8 +23,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using test::Outcome;
-using test::regex_groups;
 using test::read_bytes;
+using test::regex_groups;
 using test::run_drt;
 
 TEST(Predict, ExtrapolatesTheLastTwoErrorsAlongTheirSlopeWithATenthToSpare) {
@@ -51,10 +51,52 @@ TEST(Predict, HoldsTheSlopeBetweenMinusOneAndMinusAQuarter) {
     EXPECT_EQ(predict(steep, 0.02, 65536)->spp, static_cast<int>(std::ceil(16 * 2 * 1.1)));
 }
 
-TEST(Predict, NeedsTwoRoundsWithAnEstimate) {
-    EXPECT_FALSE(predict({{8, 1, 0.08}}, 0.01, 65536));
-    EXPECT_FALSE(predict({{8, 1, std::nullopt}, {32, 2, 0.04}}, 0.01, 65536));
+TEST(Predict, FromOneRoundTakesTheSlopeOfIndependentSamples) {
+    // Slope -1/2: an eighth of the error needs 64 times the samples: 8 * 64 * 1.1 = 563.2.
+    const auto p = predict({{8, 1.0, 0.08}}, 0.01, 65536);
+    ASSERT_TRUE(p);
+    EXPECT_EQ(p->spp, 564);
+    EXPECT_DOUBLE_EQ(p->seconds, 564 / 8.0);
+    // Rounds without an estimate are skipped: the slope is still the assumed one.
+    EXPECT_EQ(predict({{4, 1, std::nullopt}, {8, 1, 0.08}}, 0.01, 65536)->spp, 564);
+}
+
+TEST(Predict, NeedsARoundWithAPositiveEstimate) {
+    EXPECT_FALSE(predict({{8, 1, std::nullopt}}, 0.01, 65536));
     EXPECT_FALSE(predict({{8, 1, 0.0}, {32, 2, 0.0}}, 0.01, 65536));
+}
+
+TEST(NextRound, ThePredictedCountWhenWithinTheFinalStep) {
+    // 32 * 4 * 1.1 = 140.8: at most 12 times 32, so the round the target is predicted to need.
+    const std::vector<ProgressiveRound> rounds{{8, 1.0, 0.08}, {32, 2.5, 0.04}};
+    const NextRound n = next_round(rounds, 0.02, 65536);
+    EXPECT_EQ(n.spp, 141);
+    EXPECT_TRUE(n.final);
+    // Capped at the maximum, and nothing once it is reached or the target is met.
+    EXPECT_EQ(next_round(rounds, 0.02, 100).spp, 100);
+    EXPECT_EQ(next_round(rounds, 0.02, 32).spp, 0);
+    EXPECT_EQ(next_round(rounds, 0.04, 65536).spp, 0);
+}
+
+TEST(NextRound, APilotATwelfthOfAPredictionFurtherAway) {
+    // 32 * 256 * 1.1 = 9011.2 -> 9012, more than 12 times 32: a pilot of 9012 / 12 = 751.
+    const std::vector<ProgressiveRound> rounds{{8, 1.0, 0.08}, {32, 2.5, 0.04}};
+    const NextRound n = next_round(rounds, 0.0025, 65536);
+    EXPECT_EQ(n.spp, 751);
+    EXPECT_FALSE(n.final);
+    // From the first pilot alone (slope -1/2): 8 * 400 * 1.1 = 3520 -> a pilot of 294.
+    EXPECT_EQ(next_round({{8, 1.0, 0.2}}, 0.01, 65536).spp, 294);
+    // A twelfth that is less than 3 times the last round is raised to 3 times: 32 * 16 * 1.1 =
+    // 563.2 -> 564, a twelfth 47, raised to 96.
+    EXPECT_EQ(next_round(rounds, 0.01, 65536).spp, 96);
+}
+
+TEST(NextRound, AtLeastAQuarterMoreAndThreeTimesWithoutAnEstimate) {
+    // Just over the target: 100 * 1.1 would be 110, raised to 125.
+    EXPECT_EQ(next_round({{50, 1, 0.02}, {100, 2, 0.0100001}}, 0.01, 65536).spp, 125);
+    const NextRound blind = next_round({{8, 1, std::nullopt}}, 0.01, 65536);
+    EXPECT_EQ(blind.spp, 24);
+    EXPECT_FALSE(blind.final);
 }
 
 TEST(PredictedSeconds, ALineThroughTheLastTwoRoundsOrProportionalToOne) {
@@ -124,12 +166,13 @@ TEST_F(GoalCli, BadGoalsExitTwoWithTheReasonAndWriteNothing) {
 }
 
 TEST_F(GoalCli, SppIsTheMaximumAndTheImageIsThePlainRenderOfTheCountReached) {
-    // An error no 40 samples reach: the rounds stop at the maximum.
+    // An error no 40 samples reach: the rounds stop at the maximum (the pilot after the first
+    // would be far more).
     const Outcome r = run({"scene.xml", "--target-error", "1e-9", "--spp", "40", "-o", "goal.pfm",
                            "--stats", "s.json"});
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(reached(r.err), 40) << r.err;
-    EXPECT_NE(r.err.find("after rounds of 8, 32, 40 spp"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("after rounds of 8, 40 spp"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("(target 1e-09 not met)"), std::string::npos) << r.err;
     EXPECT_NE(bytes("s.json").find("\"samples_per_pixel\": 40"), std::string::npos);
     EXPECT_NE(bytes("s.json").find("\"target_met\": false"), std::string::npos);
@@ -201,11 +244,21 @@ TEST_F(GoalCli, InfoPredictsTheSamplesAndTimeFromPilots) {
     ASSERT_EQ(r.status, 0) << r.err;
     const auto groups = regex_groups(
         r.out,
-        "\npilots: 8 spp [0-9.]+ s, estimated rmse [0-9.e-]+; 32 spp [0-9.]+ s, estimated rmse "
-        "[0-9.e-]+;\npredicted for --target-error 0.005: ([0-9]+) spp, [0-9.]+ s on this machine "
-        "\\(--spp ([0-9]+) alone: [0-9.]+ s\\)\n$");
-    ASSERT_EQ(groups.size(), 3u) << r.out;
-    EXPECT_EQ(groups[1], groups[2]) << r.out;
+        "\npilots: 8 spp [0-9.]+ s, estimated rmse [0-9.e-]+;( [0-9]+ spp [0-9.]+ s, estimated "
+        "rmse [0-9.e-]+;)*\npredicted for --target-error 0.005: ([0-9]+) spp, [0-9.]+ s on this "
+        "machine \\(--spp ([0-9]+) alone: [0-9.]+ s\\)\n$");
+    ASSERT_EQ(groups.size(), 4u) << r.out;
+    EXPECT_EQ(groups[2], groups[3]) << r.out;
+    // The render to the target takes the same pilots (its rounds' errors are the same bits) and
+    // then the predicted count, which here meets the target in one step.
+    ASSERT_EQ(
+        run({"scene.xml", "--target-error", "0.005", "-o", "g.pfm", "--stats", "s.json", "-q"})
+            .status,
+        0);
+    const std::string stats = bytes("s.json");
+    EXPECT_NE(stats.find("\"target_met\": true"), std::string::npos) << stats;
+    EXPECT_NE(stats.find("{\"spp\": " + groups[2] + ", \"seconds\""), std::string::npos) << stats;
+    EXPECT_NE(stats.find("\"samples_per_pixel\": " + groups[2]), std::string::npos) << stats;
     const Outcome bad = run({"info", "scene.xml", "--target-error", "0"});
     EXPECT_EQ(bad.status, 2);
     EXPECT_EQ(bad.err,

@@ -21,6 +21,7 @@ struct ProgressiveGoal {
     std::optional<double> target_error;  // estimated RMSE to reach
     std::optional<double> time_limit;    // seconds from `start`
     int max_samples = 0;                 // per pixel, never more (--spp)
+    bool pilots_only = false;            // see render_progressively
     std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
 };
 
@@ -37,16 +38,29 @@ struct Prediction {
     double seconds = 0;
 };
 
-// The count at which the error of the last two rounds with an estimate, extrapolated along
-// their log-log slope (held between -1 and -1/4: pilots are noisy), falls to `target`, with
-// 10 % to spare, at most `max_samples`; the time from a line through the rounds' times. Absent
-// when fewer than two rounds have a positive estimate.
+// The count at which the error of the last round, extrapolated along the log-log slope of the
+// last two rounds with an estimate (held between -1 and -1/4: rounds are noisy), falls to
+// `target`, with 10 % to spare, at most `max_samples`; the time from a line through the rounds'
+// times. With one such round the slope is taken as -1/2, that of independent samples, which no
+// sampler drt has falls short of (stratified and Sobol patterns converge faster), so the count
+// errs on the large side. Absent when no round has a positive estimate.
 std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, double target,
                                   int max_samples);
 
 // Seconds a render of `spp` samples takes, from a line (set-up plus a cost per sample) through
 // the last two rounds' times; from the last round alone when there is one.
 double predicted_seconds(const std::vector<ProgressiveRound>& rounds, int spp);
+
+// The count of the round after `rounds` on the way to `target` (at most `max_samples`, 0 when
+// the target is met or max_samples reached): the predicted count itself when it is at most
+// kFinalStep times the last round's (`final`), otherwise a pilot a kFinalStep-th of it, whose
+// error against the last round's measures the slope over a wide span, so that the next
+// prediction extrapolates only kFinalStep-fold and lands on the count in one step.
+struct NextRound {
+    int spp = 0;
+    bool final = false;
+};
+NextRound next_round(const std::vector<ProgressiveRound>& rounds, double target, int max_samples);
 
 struct ProgressiveResult {
     RenderJobResult job;          // the image kept: the last complete round's
@@ -57,15 +71,18 @@ struct ProgressiveResult {
     bool stopped = false;  // a signal (options.stop) ended it; job may be incomplete
 };
 
-// The pilot rounds' counts: small enough to cost little next to the render, large enough for a
-// batch estimate of the error.
-inline constexpr int kPilotSamples[] = {8, 32};
+// The first round's count: a pilot that costs little next to the render and still has samples
+// enough for the error estimate.
+inline constexpr int kFirstPilot = 8;
+// A final round at most this many times the last round's count; see next_round.
+inline constexpr int kFinalStep = 12;
 
-// Collective under MPI. Rounds at the pilot counts, then at the predicted count (for a time
-// budget the largest predicted to fit, with a tenth to spare) until the goal is met, the budget
-// is spent or the next round would pass max_samples. A round still running when the budget runs
-// out is stopped and dropped. options.checkpoint must be absent. The scene's sample count is
-// changed during the rounds and restored afterwards.
+// Collective under MPI. A round at kFirstPilot, then for a target error the rounds next_round
+// sizes, for a time budget the largest predicted to fit (with a tenth to spare), until the goal
+// is met, the budget is spent or the next round would pass max_samples; with goal.pilots_only,
+// a target error stops before its final round (what drt info --target-error renders). A round still
+// running when the budget runs out is stopped and dropped. options.checkpoint must be absent. The
+// scene's sample count is changed during the rounds and restored afterwards.
 ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& options,
                                        const ProgressiveGoal& goal);
 
