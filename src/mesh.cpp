@@ -1,5 +1,7 @@
 #include "drt/mesh.h"
 
+#include "drt/triangle_batch.h"
+
 #include <immintrin.h>
 #include <algorithm>
 #include <bit>
@@ -88,14 +90,16 @@ struct WideRay {
     }
 
     // The children whose boxes the ray meets inside [near, far] (bit k for child k), and where
-    // it enters each.
+    // it enters each. kFlat: whether any axis may be flat (a rare ray, tested apart so that the
+    // common one runs without branches).
+    template <bool kFlat>
     int hits(const float (&lo)[3][4], const float (&hi)[3][4], float near, float far,
              __m128& entry) const {
         __m128 enter = _mm_set1_ps(near), leave = _mm_set1_ps(far);
         __m128 inside = _mm_cmple_ps(enter, leave);
         for (int k = 0; k < 3; ++k) {
             const __m128 l = _mm_load_ps(lo[k]), h = _mm_load_ps(hi[k]);
-            if (flat >> k & 1) {
+            if (kFlat && (flat >> k & 1)) {
                 inside = _mm_and_ps(
                     inside, _mm_and_ps(_mm_cmple_ps(l, above[k]), _mm_cmpge_ps(h, below[k])));
                 continue;
@@ -113,16 +117,27 @@ struct WideRay {
     // 2γ(5) in single precision and some: the relative rounding of the slab distances.
     static constexpr float kWiden = 1 + 0x1p-19f;
 
+    // x rounded to a float no smaller (no larger): the next float up from a conversion that
+    // went down, on the bits rather than by a call of nextafter.
     static float rounded_up(double x) {
         const auto f = static_cast<float>(x);
-        return f < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+        return f < x ? next_up(f) : f;
     }
     static float rounded_down(double x) {
         const auto f = static_cast<float>(x);
-        return f > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+        return f > x ? -next_up(-f) : f;
+    }
+    // (f < x for a double x: f is not +∞ and not NaN.)
+    static float next_up(float f) {
+        if (f == 0) return std::numeric_limits<float>::denorm_min();
+        const auto bits = std::bit_cast<std::uint32_t>(f);
+        return std::bit_cast<float>(f > 0 ? bits + 1 : bits - 1);
     }
 };
 
+// The traversal tests up to four triangles of a leaf at once (triangle_batch.h), for about what
+// one box test costs: a subtree of this many triangles or fewer is visited as one leaf.
+constexpr std::uint32_t kCollapsedLeaf = 4;
 // A node pushes at most three children besides the one it visits next, and no path is longer
 // than 64 nodes.
 constexpr int kStackSize = 256;
@@ -287,9 +302,15 @@ std::size_t TriangleMesh::bytes() const {
 
 void TriangleMesh::build_hierarchy(int threads) {
     if (triangles_.empty()) return;
-    const BinaryTree tree = build_binary_tree(positions_, triangles_, threads);
+    BinaryTree tree = build_binary_tree(positions_, triangles_, threads);
     lo_ = tree.nodes[0].lo;
     hi_ = tree.nodes[0].hi;
+    filter_fits_ = true;
+    for (int a = 0; a < 3; ++a) {
+        filter_fits_ = filter_fits_ &&
+                       std::max(std::abs(lo_[a]), std::abs(hi_[a])) <= FloatShearedRay::kLargest;
+    }
+    collapse_small_subtrees(tree.nodes);
     // Each wide node takes the place of at least three binary ones (but a root that is a leaf).
     nodes_.reserve(tree.nodes.size() / 3 + 1);
     widen(tree.nodes, 0);
@@ -297,6 +318,23 @@ void TriangleMesh::build_hierarchy(int threads) {
     std::vector<std::array<std::uint32_t, 3>> ordered(triangles_.size());
     for (std::size_t i = 0; i < ordered.size(); ++i) ordered[i] = triangles_[tree.order[i]];
     triangles_ = std::move(ordered);
+}
+
+void TriangleMesh::collapse_small_subtrees(std::vector<BinaryNode>& binary) {
+    // A node's children come after it (the first right after), so one pass from the end sees
+    // every subtree before its root. A subtree's triangles are one run of the leaf order.
+    std::vector<std::uint32_t> first(binary.size()), size(binary.size());
+    for (std::size_t n = binary.size(); n-- > 0;) {
+        BinaryNode& node = binary[n];
+        if (node.count > 0) {
+            first[n] = node.offset;
+            size[n] = node.count;
+            continue;
+        }
+        first[n] = first[n + 1];
+        size[n] = size[n + 1] + size[node.offset];
+        if (size[n] <= kCollapsedLeaf) node = {node.lo, node.hi, first[n], size[n]};
+    }
 }
 
 std::uint32_t TriangleMesh::widen(const std::vector<BinaryNode>& binary, std::uint32_t node) {
@@ -355,11 +393,36 @@ std::optional<MeshHit> TriangleMesh::traverse(const Ray& ray, Interval range,
     if (nodes_.empty()) return std::nullopt;
     const ShearedRay sheared(ray);
     const WideRay wide(ray, range);
+    const FloatShearedRay filter(sheared);
+    const bool use_filter = filter.usable() && filter_fits_;
+    const std::array<int, 3> axes{filter.axis(0), filter.axis(1), filter.axis(2)};
+    // The filter's near end must not be negative (triangle_batch.h); a negative range start
+    // (never used by the renderer) leaves the near end to the double test.
+    const float filter_near =
+        range.min >= 0 ? WideRay::rounded_down(range.min) : -std::numeric_limits<float>::infinity();
+    // Corners of triangles first .. first + lanes - 1 in the filter's axis order; lanes past
+    // the leaf's end repeat its last triangle and are masked off.
+    const auto gather = [&](std::uint32_t first, std::uint32_t lanes) {
+        std::array<const std::array<std::uint32_t, 3>*, 4> t{};
+        for (std::uint32_t k = 0; k < 4; ++k) t[k] = &triangles_[first + std::min(k, lanes - 1)];
+        TriangleBatch batch;
+        for (int v = 0; v < 3; ++v) {
+            const Float3 &p0 = positions_[(*t[0])[v]], &p1 = positions_[(*t[1])[v]],
+                         &p2 = positions_[(*t[2])[v]], &p3 = positions_[(*t[3])[v]];
+            for (int a = 0; a < 3; ++a) {
+                const int k = axes[a];
+                batch.corners[v][a] = _mm_setr_ps(p0[k], p1[k], p2[k], p3[k]);
+            }
+        }
+        return batch;
+    };
     const float near = WideRay::rounded_down(range.min);
     float far = WideRay::rounded_up(range.max);
     std::optional<MeshHit> best;
     // Children still to visit (a node, or a leaf's triangles), with where the ray enters their
-    // boxes: one that a nearer hit has since put out of range is skipped.
+    // boxes: one that a nearer hit has since put out of range is skipped. The nearest child of
+    // a node is visited next without going through the stack; the others are pushed farthest
+    // first.
     struct Pending {
         std::uint32_t child;
         std::uint32_t count;
@@ -367,42 +430,62 @@ std::optional<MeshHit> TriangleMesh::traverse(const Ray& ray, Interval range,
     };
     std::array<Pending, kStackSize> stack;
     int top = 0;
-    stack[top++] = {0, 0, near};
-    while (top > 0) {
-        const Pending p = stack[--top];
-        if (p.entry > far * WideRay::kWiden) continue;
-        if (p.count > 0) {
-            for (std::uint32_t i = p.child; i < p.child + p.count; ++i) {
-                if (tests) ++*tests;
-                const auto [a, b, c] = corners(i);
-                if (const auto hit = intersect_triangle(sheared, a, b, c, range)) {
-                    best = MeshHit{hit->t, i, hit->b};
-                    if constexpr (kAnyHit) return best;
-                    range.max = hit->t;
-                    far = WideRay::rounded_up(range.max);
+    Pending current{0, 0, near};
+    const bool flat = wide.flat != 0;
+    while (true) {
+        if (current.count > 0) {
+            // Four triangles at a time through the float filter; those it cannot rule out, in
+            // order, through the double test, which alone decides (triangle_batch.h).
+            const std::uint32_t end = current.child + current.count;
+            for (std::uint32_t first = current.child; first < end; first += 4) {
+                const auto lanes = std::min<std::uint32_t>(4, end - first);
+                if (tests) *tests += lanes;
+                int maybe = (1 << lanes) - 1;
+                if (use_filter) maybe &= filter.maybe_hits(gather(first, lanes), filter_near, far);
+                for (; maybe != 0; maybe &= maybe - 1) {
+                    const std::uint32_t i = first + std::countr_zero(static_cast<unsigned>(maybe));
+                    const auto [a, b, c] = corners(i);
+                    if (const auto hit = intersect_triangle(sheared, a, b, c, range)) {
+                        best = MeshHit{hit->t, i, hit->b};
+                        if constexpr (kAnyHit) return best;
+                        range.max = hit->t;
+                        far = WideRay::rounded_up(range.max);
+                    }
                 }
             }
-            continue;
+        } else {
+            const Node& node = nodes_[current.child];
+            __m128 entries;
+            const int mask = (flat ? wide.hits<true>(node.lo, node.hi, near, far, entries)
+                                   : wide.hits<false>(node.lo, node.hi, near, far, entries)) &
+                             ((1 << node.children) - 1);
+            if (mask != 0) {
+                alignas(16) float entry[4];
+                _mm_store_ps(entry, entries);
+                // The children met, nearest first; among equal entries the last child first,
+                // the order in which earlier versions visited them (so images do not change).
+                std::array<int, 4> order{};
+                int n = 0;
+                for (int m = mask; m != 0; m &= m - 1) {
+                    const int c = std::countr_zero(static_cast<unsigned>(m));
+                    int k = n++;
+                    for (; k > 0 && entry[order[k - 1]] >= entry[c]; --k) order[k] = order[k - 1];
+                    order[k] = c;
+                }
+                for (int k = n - 1; k > 0; --k) {
+                    const int c = order[k];
+                    stack[top++] = {node.child[c], node.count[c], entry[c]};
+                }
+                const int c = order[0];
+                current = {node.child[c], node.count[c], entry[c]};
+                continue;
+            }
         }
-        const Node& node = nodes_[p.child];
-        __m128 entries;
-        int mask = wide.hits(node.lo, node.hi, near, far, entries) & ((1 << node.children) - 1);
-        if (mask == 0) continue;
-        alignas(16) float entry[4];
-        _mm_store_ps(entry, entries);
-        // Pushed farthest first, so that the nearest is visited next.
-        std::array<int, 4> order{};
-        int n = 0;
-        for (; mask != 0; mask &= mask - 1)
-            order[n++] = std::countr_zero(static_cast<unsigned>(mask));
-        std::sort(order.begin(), order.begin() + n,
-                  [&](int x, int y) { return entry[x] > entry[y]; });
-        for (int k = 0; k < n; ++k) {
-            const int c = order[k];
-            stack[top++] = {node.child[c], node.count[c], entry[c]};
-        }
+        do {
+            if (top == 0) return best;
+            current = stack[--top];
+        } while (current.entry > far * WideRay::kWiden);
     }
-    return best;
 }
 
 std::optional<MeshHit> TriangleMesh::intersect(const Ray& ray, Interval range) const {

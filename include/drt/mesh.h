@@ -63,8 +63,9 @@ class TriangleMesh {
     std::optional<MeshHit> intersect(const Ray& ray, Interval range) const;
     // Whether any triangle meets the ray inside `range` (stops at the first).
     bool occluded(const Ray& ray, Interval range) const;
-    // How many triangles the query (nearest hit, or any hit) tests on its way: what the hierarchy
-    // saves, for tests and benchmarks.
+    // How many triangles the query (nearest hit, or any hit) tests on its way, counting every
+    // triangle of a batch of up to four tested together: what the hierarchy saves, for tests
+    // and benchmarks.
     std::uint64_t triangle_tests(const Ray& ray, Interval range, bool any_hit) const;
 
     std::array<Vec3, 3> corners(std::uint32_t triangle) const;
@@ -105,6 +106,8 @@ class TriangleMesh {
 
     Vec3 position(std::uint32_t vertex) const;
     void build_hierarchy(int threads);
+    // Turns every inner node whose subtree holds few triangles into a leaf of them all.
+    static void collapse_small_subtrees(std::vector<BinaryNode>& binary);
     // Turns the binary subtree at `node` into 4-wide nodes appended to nodes_; returns the index
     // of the one made for `node`.
     std::uint32_t widen(const std::vector<BinaryNode>& binary, std::uint32_t node);
@@ -118,7 +121,8 @@ class TriangleMesh {
     std::vector<Float3> normals_;    // per vertex, unit; empty for a flat mesh
     std::vector<std::array<std::uint32_t, 3>> triangles_;  // in leaf order
     std::vector<Node> nodes_;
-    Float3 lo_{}, hi_{};  // bounds of every triangle
+    Float3 lo_{}, hi_{};        // bounds of every triangle
+    bool filter_fits_ = false;  // coordinates small enough for the float filter
     std::size_t dropped_ = 0;
 };
 
