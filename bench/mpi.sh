@@ -4,7 +4,11 @@
 #   overhead: a render under `mpirun -n 1` against the same render without mpirun (want <= 1.02);
 #   split:    2 processes x 1 thread against 1 process x 2 threads, as speed (want >= 0.95);
 #   resume:   a render interrupted half way and resumed from its checkpoint against one run
-#             straight through: the time lost to the cycle.
+#             straight through: the time lost to the cycle;
+#   tail:     the seconds from the last tile handed out to the end (--stats tail_seconds), with
+#             the costliest tiles handed out first (drt's order) and row by row (--grid-order);
+#   message:  what one finished tile costs the leader of `mpirun -n 2`: receiving it, and adding
+#             it to the image (--stats microseconds_per_message).
 # Times are drt's own render seconds (--stats), which leave out process start-up; the wall-clock
 # seconds of the whole command, mpirun's start-up included, are printed beside them. As root
 # every run gets the highest priority, so that the machine's other work disturbs it less.
@@ -35,7 +39,8 @@ trap 'rm -rf "$out"' EXIT
 field() { grep -o "\"$1\": *[0-9.e+-]*" "$2" | head -1 | sed 's/.*: *//'; }
 median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 now() { date +%s.%N; }
-# Runs drt (through the command words given before --) and prints "render-seconds wall-seconds".
+# Runs drt (through the command words given before --) and prints "render-seconds wall-seconds
+# tail-seconds receive-microseconds assemble-microseconds".
 timed() {
     local launcher=()
     while [ "$1" != "--" ]; do launcher+=("$1"); shift; done
@@ -46,7 +51,14 @@ timed() {
     "${boost[@]}" "${launcher[@]}" "$drt" "$scene" --scale "$scale" -q --stats "$out/s.json" -o "$out/x.pfm" "$@" ||
         status=$?
     [ "$status" -eq 0 ] || [ "$status" -eq 130 ] || { echo "mpi: drt exited $status" >&2; exit 1; }
-    echo "$(field seconds "$out/s.json" 2>/dev/null || echo 0) $(awk -v a="$start" -v b="$(now)" 'BEGIN { print b - a }')"
+    local wall
+    wall=$(awk -v a="$start" -v b="$(now)" 'BEGIN { print b - a }')
+    local f v values=()
+    for f in seconds tail_seconds receive assemble; do
+        v=$(field "$f" "$out/s.json" 2>/dev/null || true)
+        values+=("${v:-0}")
+    done
+    echo "${values[0]} $wall ${values[1]} ${values[2]} ${values[3]}"
 }
 mpi() { echo mpirun --oversubscribe -n "$1"; }
 
@@ -55,29 +67,41 @@ size=$("$drt" info "$scene" --scale "$scale" | sed -n 's/^image: *\([0-9]*\)x\([
 width=${size%x*} height=${size#*x}
 half=$(( ((width + 15) / 16) * ((height + 15) / 16) / 2 ))
 
-for v in plain mpi1 one2 two1 straight cycle; do : >"$out/$v.r"; : >"$out/$v.w"; done
+variants="plain mpi1 one2 two1 one2g two1g straight cycle"
+for v in $variants; do for k in r w t rx as; do : >"$out/$v.$k"; done; done
 for round in $(seq "$rounds"); do
     echo "round $round of $rounds ..." >&2
-    record() { read -r r w <<<"$2"; echo "$r" >>"$out/$1.r"; echo "$w" >>"$out/$1.w"; }
+    record() {
+        read -r r w t rx as <<<"$2"
+        echo "$r" >>"$out/$1.r"; echo "$w" >>"$out/$1.w"; echo "$t" >>"$out/$1.t"
+        echo "$rx" >>"$out/$1.rx"; echo "$as" >>"$out/$1.as"
+    }
     record plain "$(timed -- --threads 1)"
     record mpi1 "$(timed $(mpi 1) -- --threads 1)"
     record one2 "$(timed -- --threads 2)"
     record two1 "$(timed $(mpi 2) -- --threads 1)"
+    record one2g "$(timed -- --threads 2 --grid-order)"
+    record two1g "$(timed $(mpi 2) -- --threads 1 --grid-order)"
     record straight "$(timed -- --threads 2 --checkpoint "$out/c.ckpt")"
-    read -r r1 w1 <<<"$(timed -- --threads 2 --checkpoint "$out/c.ckpt" --stop-after-tiles "$half")"
-    read -r r2 w2 <<<"$(timed -- --threads 2 --checkpoint "$out/c.ckpt")"
+    read -r r1 w1 _ <<<"$(timed -- --threads 2 --checkpoint "$out/c.ckpt" --stop-after-tiles "$half")"
+    read -r r2 w2 _ <<<"$(timed -- --threads 2 --checkpoint "$out/c.ckpt")"
     record cycle "$(awk -v a="$r1" -v b="$r2" -v c="$w1" -v d="$w2" 'BEGIN { print a + b, c + d }')"
 done
 m() { median <"$out/$1.$2"; }
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN { printf "%.3f", a / b }'; }
 echo "scene $scene at --scale $scale (${width}x${height}, $(( half * 2 )) tiles), $rounds rounds; medians"
-printf '%-44s %10s %10s\n' "" "render s" "wall s"
+printf '%-44s %10s %10s %10s\n' "" "render s" "wall s" "tail s"
 for v in "plain:1 process x 1 thread, no mpirun" "mpi1:mpirun -n 1, 1 thread" \
          "one2:1 process x 2 threads" "two1:mpirun -n 2, 1 thread each" \
+         "one2g:1 x 2, tiles in grid order" "two1g:mpirun -n 2 x 1, grid order" \
          "straight:straight through (--checkpoint)" "cycle:stopped half way + resumed"; do
-    printf '%-44s %10.3f %10.3f\n' "${v#*:}" "$(m "${v%%:*}" r)" "$(m "${v%%:*}" w)"
+    printf '%-44s %10.3f %10.3f %10.3f\n' "${v#*:}" "$(m "${v%%:*}" r)" "$(m "${v%%:*}" w)" \
+        "$(m "${v%%:*}" t)"
 done
 echo "overhead: MPI path / plain (render seconds)           $(ratio "$(m mpi1 r)" "$(m plain r)")   want <= 1.02"
 echo "split:    speed of 2 x 1 thread / 1 x 2 threads       $(ratio "$(m one2 r)" "$(m two1 r)")   want >= 0.95"
 echo "resume:   interrupt-and-resume / straight (render s)  $(ratio "$(m cycle r)" "$(m straight r)")"
 echo "resume:   seconds lost to the cycle (wall)            $(awk -v a="$(m cycle w)" -v b="$(m straight w)" 'BEGIN { printf "%.3f", a - b }')"
+echo "tail:     1 x 2, costly first / grid order            $(m one2 t) / $(m one2g t) s"
+echo "tail:     2 x 1, costly first / grid order            $(m two1 t) / $(m two1g t) s"
+echo "message:  leader's microseconds per finished tile     receive $(m two1 rx), assemble $(m two1 as)"

@@ -243,7 +243,15 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
       << ", \"max_depth\": " << s.max_depth << ", \"seed\": " << s.seed
       << ", \"sampler\": " << json_string(s.sampler) << ", \"threads\": " << r.stats.threads
       << ", \"processes\": " << r.stats.processes << ",\n"
-      << "  \"rays\": {\"camera\": " << rays.camera << ", \"shadow\": " << rays.shadow
+      << "  \"tail_seconds\": " << json_number(r.stats.tail_seconds) << ",\n";
+    if (r.stats.tile_messages > 0) {
+        const double n = double(r.stats.tile_messages);
+        j << "  \"tile_messages\": " << r.stats.tile_messages
+          << ", \"microseconds_per_message\": {\"receive\": "
+          << json_number(r.stats.receive_seconds / n * 1e6)
+          << ", \"assemble\": " << json_number(r.stats.assemble_seconds / n * 1e6) << "},\n";
+    }
+    j << "  \"rays\": {\"camera\": " << rays.camera << ", \"shadow\": " << rays.shadow
       << ", \"reflection\": " << rays.reflection << ", \"refraction\": " << rays.refraction
       << ", \"total\": " << rays.total() << "},\n"
       << "  \"million_rays_per_second\": "
@@ -346,6 +354,7 @@ struct RenderJob {
     std::string error_image;  // one scene only: where its per-pixel standard error goes
     double checkpoint_seconds = 30;
     std::optional<std::size_t> stop_after_tiles;
+    bool grid_order = false;
     std::stop_token stop;
     const MpiJob* mpi = nullptr;
 
@@ -494,6 +503,7 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
                                loaded->files_read.end());
     options.checkpoint_interval = std::chrono::duration<double>(job.checkpoint_seconds);
     options.stop_after_tiles = job.stop_after_tiles;
+    options.costly_first = !job.grid_order;
     options.stop = job.stop;
     options.mpi = job.mpi;
     std::optional<ProgressDisplay> display;
@@ -730,6 +740,8 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
         ->check(CLI::NonNegativeNumber);
     // For tests: stop as SIGINT would once N tiles are done.
     app.add_option("--stop-after-tiles", job.stop_after_tiles)->group("");
+    // For bench/mpi.sh: hand tiles out row by row, to measure what costly-first saves.
+    app.add_flag("--grid-order", job.grid_order)->group("");
     BatchReport report;
     report.add_to(app);
     app.set_version_flag("--version", std::string("drt ") + DRT_VERSION);

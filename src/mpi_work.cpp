@@ -99,6 +99,7 @@ class LeaderQueue final : public TileSource {
         if (tiles_.empty() || closed()) return std::nullopt;
         const Tile t = tiles_.front();
         tiles_.pop_front();
+        if (tiles_.empty()) emptied_ = Clock::now();
         return t;
     }
     std::size_t size() const override { return size_; }
@@ -112,6 +113,7 @@ class LeaderQueue final : public TileSource {
         const std::size_t n = std::min({wanted, fair, tiles_.size()});
         std::vector<Tile> out(tiles_.begin(), tiles_.begin() + static_cast<std::ptrdiff_t>(n));
         tiles_.erase(tiles_.begin(), tiles_.begin() + static_cast<std::ptrdiff_t>(n));
+        if (n > 0 && tiles_.empty()) emptied_ = Clock::now();
         return out;
     }
     void give_back(const std::vector<Tile>& tiles) {
@@ -124,6 +126,11 @@ class LeaderQueue final : public TileSource {
     }
     // After a failure: hand out nothing more.
     void close() { failed_.store(true); }
+    // When the last tile was handed out (the last time, if some came back).
+    std::optional<Clock::time_point> emptied() const {
+        const std::lock_guard lock(mutex_);
+        return emptied_;
+    }
 
   private:
     bool closed() const { return failed_.load() || stop_.stop_requested(); }
@@ -133,12 +140,16 @@ class LeaderQueue final : public TileSource {
     std::size_t size_;
     std::stop_token stop_;
     std::atomic<bool> failed_{false};
+    std::optional<Clock::time_point> emptied_;
 };
 
 // The leader's communication thread: answers requests, passes finished tiles to the sink and
 // takes back unrendered ones, until every other process has said it is done.
 void serve(const Transport& transport, const RenderContext& context, LeaderQueue& queue,
-           TileSink& sink, std::exception_ptr& error) {
+           TileSink& sink, MpiShare& share, std::exception_ptr& error) {
+    const auto seconds = [](Clock::time_point from, Clock::time_point to) {
+        return std::chrono::duration<double>(to - from).count();
+    };
     const int processes = transport.size();
     int active = processes - 1;
     while (active > 0) {
@@ -157,8 +168,10 @@ void serve(const Transport& transport, const RenderContext& context, LeaderQueue
                 break;
             }
             case kResult: {
+                const Clock::time_point start = Clock::now();
                 const std::vector<unsigned char> bytes = transport.receive(from, kResult);
                 if (error) break;  // drain the others, but add nothing more
+                const Clock::time_point received = Clock::now();
                 try {
                     sink.add(
                         decode_tile(bytes, context.tiles(), "process " + std::to_string(from)));
@@ -166,6 +179,9 @@ void serve(const Transport& transport, const RenderContext& context, LeaderQueue
                     error = std::current_exception();
                     queue.close();
                 }
+                ++share.messages;
+                share.receive_seconds += seconds(start, received);
+                share.assemble_seconds += seconds(received, Clock::now());
                 break;
             }
             case kDone:
@@ -314,8 +330,8 @@ int MpiJob::highest(int value) const {
     return transport_->highest(value);
 }
 
-int MpiJob::render(const RenderContext& context, std::vector<Tile> todo, TileSink& sink,
-                   const RenderOptions& options) const {
+MpiShare MpiJob::render(const RenderContext& context, std::vector<Tile> todo, TileSink& sink,
+                        const RenderOptions& options) const {
     RenderOptions run = options;
     if (run.threads <= 0) {
         // The machine's cores are shared by the processes this job put on it.
@@ -324,12 +340,12 @@ int MpiJob::render(const RenderContext& context, std::vector<Tile> todo, TileSin
     }
     if (leader()) {
         LeaderQueue queue(std::move(todo), options.stop);
+        MpiShare share;
         std::exception_ptr served_error;
-        std::jthread server([&] { serve(*transport_, context, queue, sink, served_error); });
-        int threads = 0;
+        std::jthread server([&] { serve(*transport_, context, queue, sink, share, served_error); });
         std::exception_ptr error;
         try {
-            threads = render_tiles(context, queue, sink, run);
+            share.threads = render_tiles(context, queue, sink, run);
         } catch (...) {
             error = std::current_exception();
             queue.close();
@@ -342,7 +358,8 @@ int MpiJob::render(const RenderContext& context, std::vector<Tile> todo, TileSin
         if (!queue.empty() && !options.stop.stop_requested()) {
             render_tiles(context, queue, sink, run);
         }
-        return threads;
+        share.emptied = queue.emptied();
+        return share;
     }
     run.on_progress = nullptr;
     WorkerQueue queue(context.tiles().size(), options.stop);
@@ -352,17 +369,17 @@ int MpiJob::render(const RenderContext& context, std::vector<Tile> todo, TileSin
         work_for_leader(*transport_, context, queue, outbox, run.threads, workers_finished,
                         options.stop);
     });
-    int threads = 0;
+    MpiShare share;
     std::exception_ptr error;
     try {
-        threads = render_tiles(context, queue, outbox, run);
+        share.threads = render_tiles(context, queue, outbox, run);
     } catch (...) {
         error = std::current_exception();
     }
     workers_finished.store(true);
     communicator.join();
     if (error) std::rethrow_exception(error);
-    return threads;
+    return share;
 }
 
 }  // namespace drt

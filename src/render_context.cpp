@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "drt/error_estimate.h"
 #include "drt/rng.h"
@@ -89,6 +90,25 @@ TileBuffer RenderContext::render_tile(const Tile& tile) const {
     return buffer;
 }
 
+std::uint64_t RenderContext::estimate_cost(const Tile& tile) const {
+    const int block = scene_.settings.samples >= 16 ? 4 : 8;
+    RayCounts rays;
+    std::uint64_t pilots = 0;
+    std::array<Color, 1> color;
+    for (int y = tile.y0; y < tile.y1; y += block) {
+        for (int x = tile.x0; x < tile.x1; x += block) {
+            const int px = std::min(x + block / 2, tile.x1 - 1);
+            const int py = std::min(y + block / 2, tile.y1 - 1);
+            const PixelSample s{scene_.settings.seed,
+                                static_cast<std::uint32_t>(py * scene_.settings.width + px), 0, 1};
+            integrator_.sample_pixel(px, py, s, color, rays);
+            ++pilots;
+        }
+    }
+    const auto pixels = static_cast<std::uint64_t>(tile.width()) * tile.height();
+    return pilots == 0 ? 0 : rays.total() * pixels / pilots;
+}
+
 RenderContext::Pixel RenderContext::plain_pixel(int x, int y, Scratch& scratch,
                                                 TileBuffer& buffer) const {
     const auto spp = static_cast<std::uint32_t>(scene_.settings.samples);
@@ -136,6 +156,17 @@ RenderContext::Pixel RenderContext::adaptive_pixel(int x, int y, Scratch& scratc
     }
     const auto n = static_cast<std::uint32_t>(luminances.size());
     return {sum / n, pixel_spread(scratch.taken, spread_kind(), buffer.error_sums), n, converged};
+}
+
+std::vector<Tile> costly_first(const RenderContext& context, std::vector<Tile> tiles, int workers) {
+    if (workers <= 1 || tiles.size() <= 1) return tiles;
+    std::vector<std::pair<std::uint64_t, Tile> > costed;
+    costed.reserve(tiles.size());
+    for (const Tile& t : tiles) costed.emplace_back(context.estimate_cost(t), t);
+    std::stable_sort(costed.begin(), costed.end(),
+                     [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (std::size_t i = 0; i < tiles.size(); ++i) tiles[i] = costed[i].second;
+    return tiles;
 }
 
 }  // namespace drt

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <chrono>
 #include <string>
+#include <thread>
 
 #include "drt/atomic_file.h"
 #include "drt/checkpoint.h"
@@ -91,26 +92,40 @@ RenderJobResult run_render_job(const Scene& scene, const RenderJobOptions& optio
             };
         }
     }
-    int threads = 0;
+    if (leader && options.costly_first) {
+        const int per_process =
+            run.threads > 0 ? run.threads : static_cast<int>(std::thread::hardware_concurrency());
+        todo = costly_first(context, std::move(todo),
+                            per_process * (options.mpi ? options.mpi->size() : 1));
+    }
+    MpiShare share;
     if (options.mpi) {
         // Elsewhere than on the leader, tiles go to the leader instead of a sink.
         ImageSink unused(0, 0, {});
-        threads = options.mpi->render(context, std::move(todo), into ? *into : unused, run);
+        share = options.mpi->render(context, std::move(todo), into ? *into : unused, run);
     } else {
         TileQueue queue(std::move(todo));
-        threads = render_tiles(context, queue, *into, run);
+        share.threads = render_tiles(context, queue, *into, run);
+        share.emptied = queue.emptied();
     }
+    const auto finished = std::chrono::steady_clock::now();
     if (!leader) {
         out.done = out.tiles;
         return out;
     }
     out.render = assembled(context, *image);
     out.done = image->tiles_done();
-    out.render.stats.threads = threads;
-    out.render.stats.processes = options.mpi ? options.mpi->size() : 1;
+    RenderStats& stats = out.render.stats;
+    stats.threads = share.threads;
+    if (share.emptied) {
+        stats.tail_seconds = std::chrono::duration<double>(finished - *share.emptied).count();
+    }
+    stats.tile_messages = share.messages;
+    stats.receive_seconds = share.receive_seconds;
+    stats.assemble_seconds = share.assemble_seconds;
+    stats.processes = options.mpi ? options.mpi->size() : 1;
     if (kept && !out.complete()) kept->write();
-    out.render.stats.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return out;
 }
 

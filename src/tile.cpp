@@ -20,6 +20,7 @@ std::vector<Tile> tile_grid(int width, int height, int size) {
 std::optional<Tile> TileQueue::next() {
     const std::size_t i = next_.fetch_add(1, std::memory_order_relaxed);
     if (i >= tiles_.size()) return std::nullopt;
+    if (i + 1 == tiles_.size()) emptied_ = std::chrono::steady_clock::now();
     return tiles_[i];
 }
 

@@ -5,9 +5,12 @@
 // process renders it, so the image cannot depend on the number of processes.
 #pragma once
 
+#include <chrono>
+#include <cstdint>
 #include <cstdlib>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "drt/render_context.h"
@@ -22,6 +25,17 @@ namespace drt {
 // hydra and other PMI launchers PMI_RANK. drt starts MPI only then, so a drt run without mpirun
 // costs and prints exactly what it did before MPI existed.
 bool launched_by_mpirun(const std::function<const char*(const char*)>& getenv = std::getenv);
+
+// What MpiJob::render did on this process.
+struct MpiShare {
+    int threads = 0;  // worker threads of this process
+    // Leader only: when its queue handed out the last tile (the start of the render's tail), and
+    // the finished tiles other processes sent, with the time its communication thread spent
+    // receiving them and adding them to the image (the per-message cost in docs/scale-out.md).
+    std::optional<std::chrono::steady_clock::time_point> emptied;
+    std::uint64_t messages = 0;
+    double receive_seconds = 0, assemble_seconds = 0;
+};
 
 // MPI, started for the life of this object; constructed only when launched_by_mpirun().
 class MpiJob {
@@ -47,10 +61,10 @@ class MpiJob {
     // Renders the tiles `todo` of `context` across all processes (collective). On the leader,
     // every finished tile goes to `sink`; elsewhere `todo` and `sink` are not used. A stop
     // requested on a process ends its share: the leader then hands out nothing more, and
-    // another process gives back the tiles it was handed but did not render. Returns the worker
-    // threads of this process.
-    int render(const RenderContext& context, std::vector<Tile> todo, TileSink& sink,
-               const RenderOptions& options) const;
+    // another process gives back the tiles it was handed but did not render. Tiles are handed
+    // out in the order of `todo`.
+    MpiShare render(const RenderContext& context, std::vector<Tile> todo, TileSink& sink,
+                    const RenderOptions& options) const;
 
   private:
     // Declared first, so destroyed last: the transport's code lives in the module.

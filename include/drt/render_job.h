@@ -30,6 +30,8 @@ struct RenderJobOptions {
     std::chrono::duration<double> checkpoint_interval = std::chrono::seconds(30);
     // For tests: stop as a signal would once this many tiles are done, resumed ones included.
     std::optional<std::size_t> stop_after_tiles;
+    // Hand the costliest tiles out first (costly_first, render_context.h); otherwise row by row.
+    bool costly_first = true;
     std::stop_token stop;
     const MpiJob* mpi = nullptr;  // absent: one process
 };

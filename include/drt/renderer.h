@@ -34,6 +34,13 @@ struct RenderStats {
     double seconds = 0;
     int threads = 1;    // worker threads of one process
     int processes = 1;  // processes of an MPI job (mpi_work.h)
+    // From the last tile handed out to the last one finished: the tail, when workers run out of
+    // work one by one. Set by run_render_job (render_job.h).
+    double tail_seconds = 0;
+    // An MPI job's leader: the finished tiles other processes sent it, and the time its
+    // communication thread spent receiving them and adding them to the image.
+    std::uint64_t tile_messages = 0;
+    double receive_seconds = 0, assemble_seconds = 0;
     RayCounts rays;
     std::uint64_t samples = 0;           // camera samples taken over all pixels
     std::uint64_t pixels_converged = 0;  // adaptive: pixels that stopped before the maximum

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <mutex>
@@ -75,9 +76,14 @@ class TileQueue final : public TileSource {
     std::optional<Tile> next() override;
     std::size_t size() const override { return tiles_.size(); }
 
+    // When the last tile was handed out, if it was: the start of the render's tail, when workers
+    // run out of work one by one while the others finish theirs. Read once the workers are done.
+    std::optional<std::chrono::steady_clock::time_point> emptied() const { return emptied_; }
+
   private:
     std::vector<Tile> tiles_;
     std::atomic<std::size_t> next_{0};
+    std::optional<std::chrono::steady_clock::time_point> emptied_;  // by the last tile's taker
 };
 
 // Assembles tile buffers into the image, the per-pixel sample counts and spreads and the

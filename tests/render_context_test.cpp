@@ -1,0 +1,64 @@
+// The cost guess that orders the tiles: rays a pilot traces, scaled to the tile, and the order
+// it gives (which changes no pixel: renderer_test.cpp renders tiles in any order).
+#include "drt/render_context.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "test_scenes.h"
+
+namespace drt {
+namespace {
+
+// A mirror sphere filling the middle of a 96 × 96 image: a camera ray there traces one
+// reflection (which leaves the convex sphere for the background); the corner tiles see only
+// background, one camera ray a pixel.
+Scene mirror_ball() {
+    return testing::lone_sphere_scene(testing::mirror({0.5, 0.5, 0.5}), {0.1, 0.2, 0.3}, 96);
+}
+
+TEST(EstimateCost, CountsThePilotsRaysScaledToTheTile) {
+    const Scene scene = mirror_ball();
+    const RenderContext context(scene, std::nullopt);
+    const std::vector<Tile>& tiles = context.tiles();
+    ASSERT_EQ(tiles.size(), 36u);
+    EXPECT_EQ(context.estimate_cost(tiles[0]), 256u);  // top left: background only
+    EXPECT_EQ(context.estimate_cost(tiles[35]), 256u);
+    EXPECT_EQ(context.estimate_cost(tiles[14]), 512u);  // beside the centre: all mirror
+    EXPECT_EQ(context.estimate_cost(tiles[21]), 512u);
+    // An edge tile of 8 × 16 pixels, background only: half the cost.
+    const Scene narrow =
+        testing::lone_sphere_scene(testing::mirror({0.5, 0.5, 0.5}), {0.1, 0.2, 0.3}, 88);
+    const RenderContext cut(narrow, std::nullopt);
+    EXPECT_EQ(cut.tiles()[5].width(), 8);
+    EXPECT_EQ(cut.estimate_cost(cut.tiles()[5]), 128u);
+}
+
+TEST(CostlyFirst, OrdersByFallingCostAndKeepsIndexOrderAmongEquals) {
+    const Scene scene = mirror_ball();
+    const RenderContext context(scene, std::nullopt);
+    const std::vector<Tile> order = costly_first(context, context.tiles(), 2);
+    ASSERT_EQ(order.size(), context.tiles().size());
+    EXPECT_TRUE(std::is_permutation(order.begin(), order.end(), context.tiles().begin()));
+    EXPECT_EQ(order.front().index, 7u);  // the first of the all-mirror tiles
+    EXPECT_EQ(order.back().index, 35u);  // the last of the background-only ones
+    for (std::size_t i = 1; i < order.size(); ++i) {
+        const auto before = context.estimate_cost(order[i - 1]);
+        const auto after = context.estimate_cost(order[i]);
+        EXPECT_GE(before, after) << i;
+        if (before == after) {
+            EXPECT_LT(order[i - 1].index, order[i].index) << i;
+        }
+    }
+}
+
+TEST(CostlyFirst, LeavesOneWorkersTilesAlone) {
+    const Scene scene = mirror_ball();
+    const RenderContext context(scene, std::nullopt);
+    EXPECT_EQ(costly_first(context, context.tiles(), 1), context.tiles());
+}
+
+}  // namespace
+}  // namespace drt
