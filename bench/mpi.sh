@@ -12,7 +12,7 @@
 # Times are drt's own render seconds (--stats), which leave out process start-up; the wall-clock
 # seconds of the whole command, mpirun's start-up included, are printed beside them. As root
 # every run gets the highest priority, so that the machine's other work disturbs it less.
-# Usage: bench/mpi.sh [--scene FILE] [--scale F] [--rounds N] [--drt PATH]
+# Usage: setsid bench/mpi.sh [--scene FILE] [--scale F] [--rounds N] [--drt PATH]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 drt=build/drt
@@ -32,7 +32,14 @@ done
 command -v mpirun >/dev/null || { echo "mpi: needs mpirun: tools/install-deps.sh" >&2; exit 2; }
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 boost=()
-[ "$(id -u)" -eq 0 ] && boost=(nice -n -20)
+if [ "$(id -u)" -eq 0 ]; then
+    boost=(nice -n -20)
+    # With autogroup scheduling (Linux's default for desktops and many servers) a nice value
+    # orders threads only within their session; between sessions the session's own nice
+    # counts, so without this the machine's other sessions get an equal share each and two
+    # threads run no faster than one. Run the bench in a session of its own: setsid bench/mpi.sh
+    if [ -w /proc/self/autogroup ]; then echo -20 >/proc/self/autogroup || true; fi
+fi
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 
