@@ -85,11 +85,13 @@ std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, d
     if (measured.empty()) return std::nullopt;
     const ProgressiveRound& b = *measured.back();
     double slope = kIndependentSlope;
-    if (measured.size() >= 2) {
-        const ProgressiveRound& a = *measured[measured.size() - 2];
-        if (a.spp == b.spp) return std::nullopt;
-        slope = std::clamp(std::log(*b.error / *a.error) / std::log(double(b.spp) / a.spp), -1.0,
-                           -0.25);
+    // The latest earlier round kMinPilotGrowth times fewer: over a narrower span (a final round
+    // that just missed after one only a little smaller) the errors' noise decides the slope.
+    const auto a = std::find_if(measured.rbegin() + 1, measured.rend(),
+                                [&](const auto* r) { return r->spp * kMinPilotGrowth <= b.spp; });
+    if (a != measured.rend()) {
+        slope = std::clamp(std::log(*b.error / *(*a)->error) / std::log(double(b.spp) / (*a)->spp),
+                           -1.0, -0.25);
     }
     double spp = b.spp;
     if (*b.error > target) spp = b.spp * std::pow(target / *b.error, 1 / slope) * kSpare;

@@ -47,8 +47,8 @@ TEST(Predict, HoldsTheSlopeBetweenMinusOneAndMinusAQuarter) {
     const std::vector<ProgressiveRound> flat{{8, 1, 0.08}, {32, 2, 0.08}};
     EXPECT_EQ(predict(flat, 0.04, 65536)->spp, static_cast<int>(std::ceil(32 * 16 * 1.1)));
     // A slope of -2 (luck) is taken as -1: half the error needs twice the samples.
-    const std::vector<ProgressiveRound> steep{{8, 1, 0.16}, {16, 2, 0.04}};
-    EXPECT_EQ(predict(steep, 0.02, 65536)->spp, static_cast<int>(std::ceil(16 * 2 * 1.1)));
+    const std::vector<ProgressiveRound> steep{{8, 1, 0.16}, {32, 2, 0.01}};
+    EXPECT_EQ(predict(steep, 0.005, 65536)->spp, static_cast<int>(std::ceil(32 * 2 * 1.1)));
 }
 
 TEST(Predict, FromOneRoundTakesTheSlopeOfIndependentSamples) {
@@ -59,6 +59,16 @@ TEST(Predict, FromOneRoundTakesTheSlopeOfIndependentSamples) {
     EXPECT_DOUBLE_EQ(p->seconds, 564 / 8.0);
     // Rounds without an estimate are skipped: the slope is still the assumed one.
     EXPECT_EQ(predict({{4, 1, std::nullopt}, {8, 1, 0.08}}, 0.01, 65536)->spp, 564);
+}
+
+TEST(Predict, TakesTheSlopeOverAtLeastThreefoldTheSamples) {
+    // 100 to 120 samples: too narrow a span for a slope, so -1/2 from the last round:
+    // 120 * 1.21 * 1.1 = 159.72.
+    EXPECT_EQ(predict({{100, 1, 0.2}, {120, 1, 0.011}}, 0.01, 65536)->spp, 160);
+    // With a round a third as large before them, the slope from it: 40 to 120 samples, error
+    // 0.022 to 0.011, slope -0.63; 120 * 1.1^(1 / 0.63) * 1.1 = 153.5.
+    const std::vector<ProgressiveRound> rounds{{40, 1, 0.022}, {100, 1, 0.2}, {120, 1, 0.011}};
+    EXPECT_EQ(predict(rounds, 0.01, 65536)->spp, 154);
 }
 
 TEST(Predict, NeedsARoundWithAPositiveEstimate) {

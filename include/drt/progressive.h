@@ -38,12 +38,13 @@ struct Prediction {
     double seconds = 0;
 };
 
-// The count at which the error of the last round, extrapolated along the log-log slope of the
-// last two rounds with an estimate (held between -1 and -1/4: rounds are noisy), falls to
-// `target`, with 10 % to spare, at most `max_samples`; the time from a line through the rounds'
-// times. With one such round the slope is taken as -1/2, that of independent samples, which no
-// sampler drt has falls short of (stratified and Sobol patterns converge faster), so the count
-// errs on the large side. Absent when no round has a positive estimate.
+// The count at which the error of the last round, extrapolated along the log-log slope from the
+// latest round with an estimate and at most a third of its count (held between -1 and -1/4:
+// rounds are noisy), falls to `target`, with 10 % to spare, at most `max_samples`; the time from
+// a line through the rounds' times. Without such a round the slope is taken as -1/2, that of
+// independent samples, which no sampler drt has falls short of (stratified and Sobol patterns
+// converge faster), so the count errs on the large side. Absent when no round has a positive
+// estimate.
 std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, double target,
                                   int max_samples);
 
