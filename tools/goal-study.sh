@@ -1,30 +1,111 @@
-#!/bin/sh
-# Rendering to a goal, measured: for each thesis scene, drt converge --target-error E prints the
-# pilots' prediction (spp, seconds) and where the measured RMSE reaches E (the cheapest fixed
-# count), and drt SCENE --target-error E renders to it; the table compares prediction, the goal
-# render and the cheapest fixed count, and the goal render's true RMSE against the reference.
-# usage: tools/goal-study.sh [DRT] [E] [SCALE] > table.md   (docs/accuracy.md, section 6)
-set -eu
-drt=${1:-build/drt}
-target=${2:-0.005}
-scale=${3:-0.1}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-echo "| scene | predicted spp | predicted s | goal spp | goal s | goal estimated RMSE | goal true RMSE | true / E | cheapest fixed spp | its s | goal s / fixed s |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|"
-for scene in scenes/thesis/test*.xml; do
-    name=$(basename "$scene" .xml)
-    "$drt" converge "$scene" --scale "$scale" --spp 16,32,64,128,256,512,1024 --reference-spp 4096 \
-        --target-error "$target" --save-reference "$work/ref.pfm" > "$work/converge.txt"
-    "$drt" "$scene" --scale "$scale" --target-error "$target" -o "$work/goal.pfm" \
-        --stats "$work/goal.json" -q
-    predicted=$(sed -n 's/^predicted for --target-error [^:]*: \([0-9]*\) spp, \([0-9.]*\) s.*/\1 | \2/p' "$work/converge.txt")
-    measured=$(sed -n 's/^measured for rmse [^:]*: \([0-9]*\) spp, \([0-9.]*\) s.*/\1 | \2/p' "$work/converge.txt")
-    goal_spp=$(sed -n 's/.*"samples_per_pixel": \([0-9]*\).*/\1/p' "$work/goal.json")
-    goal_s=$(sed -n 's/^  "seconds": \([0-9.e-]*\).*/\1/p' "$work/goal.json")
-    goal_est=$(sed -n 's/.*"estimated_rmse": \([0-9.e-]*\).*/\1/p' "$work/goal.json" | head -1)
-    true_rmse=$("$drt" compare "$work/goal.pfm" "$work/ref.pfm" | sed 's/rmse=\([^ ]*\).*/\1/')
-    fixed_s=${measured#*| }
-    echo "| $name | $predicted | $goal_spp | $goal_s | $goal_est | $true_rmse | $(echo "$true_rmse / $target" | bc -l | cut -c1-4) | $measured | $(echo "$goal_s / $fixed_s" | bc -l | cut -c1-4) |"
-    cp "$work/converge.txt" "/tmp/goal-study-$name.txt" 2>/dev/null || true
+#!/usr/bin/env bash
+# Rendering to a goal, measured (docs/accuracy.md, section 6). For each thesis scene and target E:
+# - the prediction: drt info SCENE --target-error E (its predicted count and seconds);
+# - the goal render: drt SCENE --target-error E (its count, rounds, estimated and true RMSE);
+# - the cheapest fixed count whose true RMSE reaches E, found by doubling and then bisecting
+#   --spp N against a 4096-spp reference of another seed (assumes the error falls with N);
+# - the time of the goal render and of that fixed count, timed side by side and alternating,
+#   pinned to one core at high priority (run as root for nice -20), --repeat times each.
+# Writes goal-study.csv to the work folder and prints a markdown table;
+# tools/goal-plot.sh draws docs/images/accuracy-goal.png from the CSV.
+#
+# usage: tools/goal-study.sh [--drt BIN] [--scale S] [--targets E1,E2,..] [--work DIR]
+#                            [--repeat N] [--cpu C] [--scenes "test1 test2 .."]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+drt=$root/build/drt
+scale=0.1
+targets=0.01,0.005
+work=$root/build/goal-study
+repeat=3
+cpu=1
+scenes="test1 test2 test3 test4 test5 test6"
+while [ $# -gt 0 ]; do
+    case "$1" in
+        --drt) drt=$(realpath "$2"); shift 2 ;;
+        --scale) scale=$2; shift 2 ;;
+        --targets) targets=$2; shift 2 ;;
+        --work) work=$2; shift 2 ;;
+        --repeat) repeat=$2; shift 2 ;;
+        --cpu) cpu=$2; shift 2 ;;
+        --scenes) scenes=$2; shift 2 ;;
+        *) echo "goal-study: unknown option $1" >&2; exit 2 ;;
+    esac
+done
+mkdir -p "$work"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+log() { echo "[$(date +%H:%M:%S)] $*" >&2; }
+# Pinned and at high priority, so that the compared runs see the same core.
+pinned() { nice -n -20 taskset -c "$cpu" "$@"; }
+# wall SECONDS_VAR COMMAND...: runs it pinned and stores its wall-clock seconds.
+wall() {
+    local -n out=$1
+    shift
+    local t0 t1
+    t0=$(date +%s.%N)
+    pinned "$@" >/dev/null 2>&1
+    t1=$(date +%s.%N)
+    out=$(echo "$t1 - $t0" | bc -l)
+}
+json() { sed -n "s/.*\"$1\": \\([0-9.e+-]*\\).*/\\1/p" "$2" | head -1; }
+median() { tr ' ' '\n' | sort -g | awk '{v[NR] = $1} END {print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
+
+csv=$work/goal-study.csv
+echo "scene,target,predicted_spp,predicted_s,goal_spp,goal_rounds,goal_s,goal_render_s,goal_estimated,goal_true,fixed_spp,fixed_s,fixed_render_s,fixed_true" >"$csv"
+for name in $scenes; do
+    scene=$root/scenes/thesis/$name.xml
+    ref=$work/$name-$scale-ref.pfm
+    if [ ! -f "$ref" ]; then
+        log "$name: reference (4096 spp, seed 1)"
+        "$drt" "$scene" --scale "$scale" --spp 4096 --seed 1 -q -o "$ref"
+    fi
+    # rmse_at N: the true RMSE of --spp N (kept in the work folder: it is called in subshells,
+    # and the images of --spp N are the same for every build that renders them bit-identically).
+    rmse_at() {
+        local kept=$work/$name-$scale.$1.rmse
+        if [ ! -f "$kept" ]; then
+            "$drt" "$scene" --scale "$scale" --spp "$1" -q -o "$tmp/fixed.pfm"
+            "$drt" compare "$tmp/fixed.pfm" "$ref" | sed 's/rmse=\([^ ]*\).*/\1/' >"$kept"
+        fi
+        cat "$kept"
+    }
+    meets() { [ "$(echo "$(rmse_at "$1") <= $2" | bc -l)" = 1 ]; }
+    for target in ${targets//,/ }; do
+        lo=1 hi=4
+        until meets "$hi" "$target"; do lo=$hi; hi=$((hi * 2)); done
+        while [ $((hi - lo)) -gt 1 ]; do
+            mid=$(((lo + hi) / 2))
+            if meets "$mid" "$target"; then hi=$mid; else lo=$mid; fi
+        done
+        fixed=$hi
+        log "$name E=$target: cheapest fixed count $fixed (true RMSE $(rmse_at "$fixed"))"
+        pinned "$drt" info "$scene" --scale "$scale" --threads 1 --target-error "$target" >"$tmp/info.txt"
+        predicted=$(sed -n 's/^predicted for --target-error [^:]*: \([0-9]*\) spp, \([0-9.]*\) s.*/\1,\2/p' "$tmp/info.txt")
+        goal_times="" fixed_times=""
+        for ((k = 1; k <= repeat; k++)); do
+            wall t "$drt" "$scene" --scale "$scale" --threads 1 --target-error "$target" \
+                -o "$tmp/goal.pfm" --stats "$tmp/goal.json"
+            goal_times+=" $t"
+            wall t "$drt" "$scene" --scale "$scale" --threads 1 --spp "$fixed" \
+                -o "$tmp/fixed.pfm" --stats "$tmp/fixed.json"
+            fixed_times+=" $t"
+        done
+        goal_s=$(echo $goal_times | median)
+        fixed_s=$(echo $fixed_times | median)
+        goal_spp=$(json samples_per_pixel "$tmp/goal.json")
+        rounds=$(grep -o '"spp": [0-9]*' "$tmp/goal.json" | sed 's/"spp": //' | paste -sd' ')
+        estimated=$(json estimated_rmse "$tmp/goal.json")
+        goal_true=$("$drt" compare "$tmp/goal.pfm" "$ref" | sed 's/rmse=\([^ ]*\).*/\1/')
+        echo "$name,$target,$predicted,$goal_spp,$rounds,$goal_s,$(json seconds "$tmp/goal.json"),$estimated,$goal_true,$fixed,$fixed_s,$(json seconds "$tmp/fixed.json"),$(rmse_at "$fixed")" >>"$csv"
+        log "$name E=$target: goal $goal_s s ($rounds spp), fixed $fixed_s s"
+    done
+done
+
+echo "| scene | E | predicted spp | predicted s | goal rounds (spp) | goal s | goal estimated RMSE | goal true RMSE | true / E | cheapest fixed spp (true RMSE ≤ E) | its s | goal s / fixed s |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
+tail -n +2 "$csv" | while IFS=, read -r name target pspp ps gspp rounds gs grs gest gtrue fspp fs frs ftrue; do
+    printf '| %s | %s | %s | %.2f | %s | %.2f | %.5f | %.5f | %.2f | %s | %.2f | %.2f |\n' \
+        "$name" "$target" "$pspp" "$ps" "${rounds// /, }" "$gs" "$gest" "$gtrue" \
+        "$(echo "$gtrue / $target" | bc -l)" "$fspp" "$fs" "$(echo "$gs / $fs" | bc -l)"
 done
