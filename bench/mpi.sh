@@ -4,7 +4,8 @@
 #   overhead: a render under `mpirun -n 1` against the same render without mpirun (want <= 1.02);
 #   split:    2 processes x 1 thread against 1 process x 2 threads, as speed (want >= 0.95);
 #   resume:   a render interrupted half way and resumed from its checkpoint against one run
-#             straight through: the time lost to the cycle;
+#             straight through: the time lost to the cycle, in wall-clock seconds (a stopped
+#             render writes no --stats, so it has no render seconds);
 #   tail:     the seconds from the last tile handed out to the end (--stats tail_seconds), with
 #             the costliest tiles handed out first (drt's order) and row by row (--grid-order);
 #   message:  what one finished tile costs the leader of `mpirun -n 2`: receiving it, and adding
@@ -55,6 +56,7 @@ timed() {
     local start status
     start=$(now)
     status=0
+    rm -f "$out/s.json"  # a stopped render writes none: its render seconds are unknown (0)
     "${boost[@]}" "${launcher[@]}" "$drt" "$scene" --scale "$scale" -q --stats "$out/s.json" -o "$out/x.pfm" "$@" ||
         status=$?
     [ "$status" -eq 0 ] || [ "$status" -eq 130 ] || { echo "mpi: drt exited $status" >&2; exit 1; }
@@ -107,7 +109,7 @@ for v in "plain:1 process x 1 thread, no mpirun" "mpi1:mpirun -n 1, 1 thread" \
 done
 echo "overhead: MPI path / plain (render seconds)           $(ratio "$(m mpi1 r)" "$(m plain r)")   want <= 1.02"
 echo "split:    speed of 2 x 1 thread / 1 x 2 threads       $(ratio "$(m one2 r)" "$(m two1 r)")   want >= 0.95"
-echo "resume:   interrupt-and-resume / straight (render s)  $(ratio "$(m cycle r)" "$(m straight r)")"
+echo "resume:   interrupt-and-resume / straight (wall)      $(ratio "$(m cycle w)" "$(m straight w)")"
 echo "resume:   seconds lost to the cycle (wall)            $(awk -v a="$(m cycle w)" -v b="$(m straight w)" 'BEGIN { printf "%.3f", a - b }')"
 echo "tail:     1 x 2, costly first / grid order            $(m one2 t) / $(m one2g t) s"
 echo "tail:     2 x 1, costly first / grid order            $(m two1 t) / $(m two1g t) s"

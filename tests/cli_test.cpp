@@ -495,6 +495,10 @@ TEST_F(CliTest, StatsJsonHasEveryContractKeyAndRaysAddUp) {
     EXPECT_EQ(std::get<std::string>(j["sampler"].value), "stratified");
     EXPECT_EQ(j["mean_spp"].number(), 3);
     EXPECT_GE(j["million_rays_per_second"].number(), 0);
+    // The tail is part of the render; a single process receives no tile messages.
+    EXPECT_GE(j["tail_seconds"].number(), 0);
+    EXPECT_LE(j["tail_seconds"].number(), j["seconds"].number());
+    EXPECT_EQ(r.out.find("tile_messages"), std::string::npos) << r.out;
     const Json& effects = j["effects"];
     EXPECT_TRUE(effects["antialiasing"].boolean());
     EXPECT_TRUE(effects["soft_shadows"].boolean());
