@@ -318,6 +318,29 @@ void TriangleMesh::build_hierarchy(int threads) {
     std::vector<std::array<std::uint32_t, 3>> ordered(triangles_.size());
     for (std::size_t i = 0; i < ordered.size(); ++i) ordered[i] = triangles_[tree.order[i]];
     triangles_ = std::move(ordered);
+    order_vertices_by_leaves();
+}
+
+void TriangleMesh::order_vertices_by_leaves() {
+    constexpr auto kUnseen = std::numeric_limits<std::uint32_t>::max();
+    std::vector<std::uint32_t> renumbered(positions_.size(), kUnseen);
+    std::uint32_t next = 0;
+    for (auto& t : triangles_) {
+        for (std::uint32_t& v : t) {
+            if (renumbered[v] == kUnseen) renumbered[v] = next++;
+            v = renumbered[v];
+        }
+    }
+    for (std::uint32_t& r : renumbered) {
+        if (r == kUnseen) r = next++;  // a vertex of dropped triangles only
+    }
+    const auto permuted = [&](const std::vector<Float3>& from) {
+        std::vector<Float3> to(from.size());
+        for (std::size_t v = 0; v < from.size(); ++v) to[renumbered[v]] = from[v];
+        return to;
+    };
+    positions_ = permuted(positions_);
+    if (!normals_.empty()) normals_ = permuted(normals_);
 }
 
 void TriangleMesh::collapse_small_subtrees(std::vector<BinaryNode>& binary) {
@@ -478,6 +501,12 @@ std::optional<MeshHit> TriangleMesh::traverse(const Ray& ray, Interval range,
                 }
                 const int c = order[0];
                 current = {node.child[c], node.count[c], entry[c]};
+                // The nearest child's second cache line is fetched while its first is tested
+                // (on a mesh of a million triangles most nodes come from memory).
+                if (current.count == 0) {
+                    _mm_prefetch(reinterpret_cast<const char*>(&nodes_[current.child]) + 64,
+                                 _MM_HINT_T0);
+                }
                 continue;
             }
         }
