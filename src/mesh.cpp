@@ -13,6 +13,8 @@
 #include <thread>
 #include <unordered_map>
 
+#include "drt/huge_pages.h"
+
 namespace drt {
 
 namespace {
@@ -313,10 +315,13 @@ void TriangleMesh::build_hierarchy(int threads) {
     collapse_small_subtrees(tree.nodes);
     // Each wide node takes the place of at least three binary ones (but a root that is a leaf).
     nodes_.reserve(tree.nodes.size() / 3 + 1);
+    prefer_huge_pages(nodes_);
     widen(tree.nodes, 0);
     nodes_.shrink_to_fit();
-    std::vector<std::array<std::uint32_t, 3>> ordered(triangles_.size());
-    for (std::size_t i = 0; i < ordered.size(); ++i) ordered[i] = triangles_[tree.order[i]];
+    std::vector<std::array<std::uint32_t, 3>> ordered;
+    ordered.reserve(triangles_.size());
+    prefer_huge_pages(ordered);
+    for (const std::uint32_t t : tree.order) ordered.push_back(triangles_[t]);
     triangles_ = std::move(ordered);
     order_vertices_by_leaves();
 }
