@@ -49,6 +49,17 @@ Vec3 rotate_z(const Vec3& v, SinCos r) {
     return {v.x * r.cos - v.y * r.sin, v.x * r.sin + v.y * r.cos, v.z};
 }
 
+// The rotation of a MeshTransform, its sines and cosines worked out once for all vertices.
+struct Rotation {
+    SinCos x, y, z;
+
+    explicit Rotation(const Vec3& degrees)
+        : x(sincos_degrees(degrees.x)),
+          y(sincos_degrees(degrees.y)),
+          z(sincos_degrees(degrees.z)) {}
+    Vec3 operator()(const Vec3& v) const { return rotate_z(rotate_y(rotate_x(v, x), y), z); }
+};
+
 Vec3 to_vec3(const std::array<float, 3>& f) {
     return {f[0], f[1], f[2]};
 }
@@ -151,17 +162,30 @@ Vec3 MeshTransform::apply(const Vec3& v) const {
 }
 
 Vec3 MeshTransform::rotate(const Vec3& v) const {
-    return rotate_z(
-        rotate_y(rotate_x(v, sincos_degrees(rotate_degrees.x)), sincos_degrees(rotate_degrees.y)),
-        sincos_degrees(rotate_degrees.z));
+    return Rotation(rotate_degrees)(v);
 }
 
 TriangleMesh::TriangleMesh(const ObjMesh& obj, const MeshTransform& transform, bool smooth,
                            int build_threads) {
+    take(obj, transform, smooth);
+    build_hierarchy(build_threads);
+}
+
+TriangleMesh::TriangleMesh(ObjMesh&& obj, const MeshTransform& transform, bool smooth,
+                           int build_threads) {
+    take(obj, transform, smooth);
+    // The file's arrays (in double) are larger than the mesh: gone before the hierarchy's
+    // working arrays are made, they keep the peak down.
+    obj = {};
+    build_hierarchy(build_threads);
+}
+
+void TriangleMesh::take(const ObjMesh& obj, const MeshTransform& transform, bool smooth) {
+    const Rotation rotation(transform.rotate_degrees);
     std::vector<Vec3> placed(obj.positions.size());
     Bounds box;
     for (std::size_t i = 0; i < placed.size(); ++i) {
-        placed[i] = transform.apply(obj.positions[i]);
+        placed[i] = rotation(obj.positions[i] * transform.scale);
         box.grow(placed[i]);
     }
     origin_ = box.empty() ? Vec3{} : box.centre();
@@ -212,9 +236,14 @@ TriangleMesh::TriangleMesh(const ObjMesh& obj, const MeshTransform& transform, b
         triangles_.push_back({vertex(p[0], n[0]), vertex(p[1], n[1]), vertex(p[2], n[2])});
     }
 
-    positions_.resize(vertex_position.size());
-    for (std::size_t v = 0; v < positions_.size(); ++v)
-        positions_[v] = local_positions[vertex_position[v]];
+    if (file_normals) {
+        positions_.resize(vertex_position.size());
+        for (std::size_t v = 0; v < positions_.size(); ++v)
+            positions_[v] = local_positions[vertex_position[v]];
+    } else {
+        positions_ = std::move(local_positions);
+    }
+    const std::vector<Float3>& by_position = file_normals ? local_positions : positions_;
 
     if (smooth) {
         // Angle-weighted face normals (Thürmer & Wüthrich 1998): unlike area weights they do not
@@ -223,8 +252,8 @@ TriangleMesh::TriangleMesh(const ObjMesh& obj, const MeshTransform& transform, b
         for (const auto& t : triangles_) {
             const std::array<std::uint32_t, 3> p{vertex_position[t[0]], vertex_position[t[1]],
                                                  vertex_position[t[2]]};
-            const Vec3 a = to_vec3(local_positions[p[0]]), b = to_vec3(local_positions[p[1]]),
-                       c = to_vec3(local_positions[p[2]]);
+            const Vec3 a = to_vec3(by_position[p[0]]), b = to_vec3(by_position[p[1]]),
+                       c = to_vec3(by_position[p[2]]);
             const Vec3 n = normalize(cross(b - a, c - a));
             computed[p[0]] += n * corner_angle(a, b, c);
             computed[p[1]] += n * corner_angle(b, c, a);
@@ -234,7 +263,7 @@ TriangleMesh::TriangleMesh(const ObjMesh& obj, const MeshTransform& transform, b
         for (std::size_t v = 0; v < normals_.size(); ++v) {
             Vec3 n = computed[vertex_position[v]];
             if (file_normals && vertex_normal[v] != ObjMesh::kNoNormal) {
-                const Vec3 given = transform.rotate(obj.normals[vertex_normal[v]]);
+                const Vec3 given = rotation(obj.normals[vertex_normal[v]]);
                 if (max_abs_component(given) > 0) n = given;
             }
             // A normal that cancelled out stays zero; shading falls back to the face's.
@@ -244,9 +273,6 @@ TriangleMesh::TriangleMesh(const ObjMesh& obj, const MeshTransform& transform, b
                            static_cast<float>(n.z)};
         }
     }
-    build_hierarchy(build_threads > 0
-                        ? build_threads
-                        : static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
 }
 
 Vec3 TriangleMesh::position(std::uint32_t vertex) const {
@@ -304,6 +330,7 @@ std::size_t TriangleMesh::bytes() const {
 
 void TriangleMesh::build_hierarchy(int threads) {
     if (triangles_.empty()) return;
+    if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     BinaryTree tree = build_binary_tree(positions_, triangles_, threads);
     lo_ = tree.nodes[0].lo;
     hi_ = tree.nodes[0].hi;

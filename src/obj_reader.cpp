@@ -13,6 +13,7 @@
 #include <memory>
 #include <system_error>
 
+#include "drt/huge_pages.h"
 #include "drt/limits.h"
 #include "drt/text.h"
 
@@ -199,11 +200,14 @@ std::string read_text(const std::filesystem::path& path) {
     // A regular file's size is known before reading; an endless input (/dev/zero) is caught as
     // it is read.
     struct stat info {};
-    if (::fstat(::fileno(file.get()), &info) == 0 && S_ISREG(info.st_mode) &&
-        static_cast<std::uint64_t>(info.st_size) > kMaxObjBytes) {
-        throw too_large();
-    }
     std::string contents;
+    if (::fstat(::fileno(file.get()), &info) == 0 && S_ISREG(info.st_mode)) {
+        const auto size = static_cast<std::uint64_t>(info.st_size);
+        if (size > kMaxObjBytes) throw too_large();
+        // Room for the whole file at once: growing by doubling would copy it and hold it twice.
+        contents.reserve(size);
+        prefer_huge_pages(contents.data(), contents.capacity());
+    }
     char buffer[1 << 16];
     std::size_t n = 0;
     while ((n = std::fread(buffer, 1, sizeof buffer, file.get())) > 0) {

@@ -710,7 +710,7 @@ class SceneReader {
         SurfaceSpec surface = read_surface(in);
         in.warn_unknown();
         warn_children(e);
-        auto mesh = build_mesh(in, obj, {}, false);
+        auto mesh = build_mesh(in, std::move(obj), {}, false);
         if (mesh->dropped() > 0) context_.warn(e, "<Triangle> of zero area dropped");
         pending_.push_back({&e, std::move(material), std::move(surface),
                             [mesh = std::move(mesh)](const Material& m, SurfaceDetail d) {
@@ -746,7 +746,7 @@ class SceneReader {
         } catch (const ObjError& error) {
             throw SceneError(error.what());
         }
-        auto mesh = build_mesh(in, obj, transform, smooth);
+        auto mesh = build_mesh(in, std::move(obj), transform, smooth);
         if (const std::size_t n = mesh->dropped(); n > 0) {
             context_.warn(e, std::to_string(n) + (n == 1 ? " triangle" : " triangles") +
                                  " of zero area in " + obj_path.string() + " dropped");
@@ -758,11 +758,11 @@ class SceneReader {
              }});
     }
 
-    static std::shared_ptr<const TriangleMesh> build_mesh(const Attributes& in, const ObjMesh& obj,
+    static std::shared_ptr<const TriangleMesh> build_mesh(const Attributes& in, ObjMesh&& obj,
                                                           const MeshTransform& transform,
                                                           bool smooth) {
         try {
-            return std::make_shared<const TriangleMesh>(obj, transform, smooth);
+            return std::make_shared<const TriangleMesh>(std::move(obj), transform, smooth);
         } catch (const std::domain_error& error) {
             in.fail(error.what());
         }

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <vector>
 
+#include "drt/mesh.h"
 #include "drt/rng.h"
 #include "test_meshes.h"
 
@@ -158,6 +159,25 @@ TEST(MeshBuild, BuildsTheTreeItAlwaysHas) {
     const Soup soup = scattered(100000);
     EXPECT_EQ(fingerprint(build_binary_tree(soup.positions, soup.triangles, 2)),
               1767449823187891288u);
+}
+
+// A mesh made from a file it may empty (the scene loader's, which lowers the peak memory) is the
+// mesh made from one it keeps, with smooth normals from the file and computed ones.
+TEST(MeshBuild, AMeshFromAnObjItEmptiesIsTheSameMesh) {
+    ObjMesh obj = testing::obj_of(testing::icosphere(3));
+    obj.normals = {{0, 0, 2}};
+    obj.normal_indices[4] = 0;
+    const MeshTransform turn{2, {10, 20, 30}};
+    const TriangleMesh kept(obj, turn, true);
+    const TriangleMesh emptied(std::move(obj), turn, true);
+    EXPECT_TRUE(obj.positions.empty() && obj.position_indices.empty());
+    EXPECT_EQ(emptied.origin(), kept.origin());
+    EXPECT_TRUE(std::ranges::equal(emptied.positions(), kept.positions()));
+    EXPECT_TRUE(std::ranges::equal(emptied.triangles(), kept.triangles()));
+    EXPECT_TRUE(std::ranges::equal(emptied.hierarchy(), kept.hierarchy()));
+    for (std::uint32_t t = 0; t < kept.triangle_count(); ++t)
+        EXPECT_EQ(emptied.shading_normal(t, {0.2, 0.3, 0.5}),
+                  kept.shading_normal(t, {0.2, 0.3, 0.5}));
 }
 
 }  // namespace

@@ -51,6 +51,8 @@ class TriangleMesh {
     // whatever their number.
     TriangleMesh(const ObjMesh& obj, const MeshTransform& transform, bool smooth,
                  int build_threads = 0);
+    // The same, emptying `obj` before the hierarchy is built, which lowers the peak memory.
+    TriangleMesh(ObjMesh&& obj, const MeshTransform& transform, bool smooth, int build_threads = 0);
 
     std::size_t triangle_count() const { return triangles_.size(); }
     std::size_t dropped() const { return dropped_; }
@@ -105,7 +107,10 @@ class TriangleMesh {
         std::uint32_t unused;  // 0: a node has no padding bytes of unknown value
     };
 
+    // The vertices, triangles and normals of the mesh from the file's.
+    void take(const ObjMesh& obj, const MeshTransform& transform, bool smooth);
     Vec3 position(std::uint32_t vertex) const;
+    // `threads` 0: one per core.
     void build_hierarchy(int threads);
     // Numbers the vertices in the order the leaves first use them, so that a leaf's corners
     // are near each other in memory (on a large mesh they were a cache miss each).
