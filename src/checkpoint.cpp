@@ -21,8 +21,9 @@ using Bytes = std::vector<unsigned char>;
 
 // "DRTCKPT" and a format number: a reader refuses a format it does not know instead of guessing.
 // Format 2 added each pixel's spread and each tile's error sums (error_estimate.h); format 3
-// fingerprints each file the scene reads on its own (format 2 had one hash for them all).
-constexpr char kMagic[8] = {'D', 'R', 'T', 'C', 'K', 'P', 'T', '3'};
+// fingerprints each file the scene reads on its own (format 2 had one hash for them all); format 4
+// holds the error sums of the estimate's calibration instead of sobol's run spreads.
+constexpr char kMagic[8] = {'D', 'R', 'T', 'C', 'K', 'P', 'T', '4'};
 // The longest version string a reader accepts, so a damaged length cannot ask for gigabytes.
 constexpr std::uint32_t kMaxVersionLength = 256;
 // Likewise for a file's name (PATH_MAX on Linux).
@@ -47,10 +48,10 @@ class Writer {
         for (float v : t.pixels.rgb) f32(v);
         for (std::uint32_t n : t.pixel_samples) u32(n);
         for (float v : t.spread.rgb) f32(v);
-        for (std::size_t k = 0; k < t.error_sums.runs.size(); ++k) {
-            f64(t.error_sums.runs[k]);
-            f64(t.error_sums.runs_pixels[k]);
-        }
+        f64(t.error_sums.variance);
+        f64(t.error_sums.spread);
+        f64(t.error_sums.pixels);
+        f64(t.error_sums.samples);
         u64(t.rays.camera);
         u64(t.rays.shadow);
         u64(t.rays.reflection);
@@ -98,10 +99,10 @@ class Reader {
         t.spread = Image(t.tile.width(), t.tile.height());
         need(t.spread.rgb.size() * 4);
         for (float& v : t.spread.rgb) v = f32();
-        for (std::size_t k = 0; k < t.error_sums.runs.size(); ++k) {
-            t.error_sums.runs[k] = f64();
-            t.error_sums.runs_pixels[k] = f64();
-        }
+        t.error_sums.variance = f64();
+        t.error_sums.spread = f64();
+        t.error_sums.pixels = f64();
+        t.error_sums.samples = f64();
         t.rays.camera = u64();
         t.rays.shadow = u64();
         t.rays.reflection = u64();

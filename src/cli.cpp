@@ -261,7 +261,8 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
     const ErrorEstimate& error = r.stats.error;
     if (error.available()) {
         j << "  \"estimated_rmse\": " << json_number(*error.rmse)
-          << ", \"estimated_relmse\": " << json_number(*error.relmse) << ",\n";
+          << ", \"estimated_relmse\": " << json_number(*error.relmse)
+          << ", \"estimate_cost\": " << json_number(error.cost) << ",\n";
     } else {
         j << "  \"estimated_rmse\": null, \"estimated_relmse\": null, \"estimate_unavailable\": "
           << json_string(error.unavailable) << ",\n";

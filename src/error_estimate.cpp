@@ -1,7 +1,6 @@
 #include "drt/error_estimate.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -12,77 +11,67 @@ namespace drt {
 
 namespace {
 
-constexpr std::array<int, 3> kRuns = {2, 4, 8};
-
-// Sample variance per channel (Welford's update, steady for many similar values).
-Color sample_variance(std::span<const Color> x) {
-    Color mean, m2;
-    for (std::size_t i = 0; i < x.size(); ++i) {
-        const Color delta = x[i] - mean;
-        mean += delta / double(i + 1);
-        m2 += delta * (x[i] - mean);
-    }
-    return m2 / double(x.size() - 1);
-}
-
 double sum(const Color& c) {
     return c.r + c.g + c.b;
-}
-
-// Fits T_B = sigma2 * (B^beta - 1) to the run sums of the run counts `b` (log least squares over
-// a grid of beta: deterministic and free of starting guesses). Returns {sigma2, beta}.
-std::pair<double, double> fit_runs(std::span<const double> b, std::span<const double> t) {
-    double best = std::numeric_limits<double>::infinity(), best_beta = 1, best_log = 0;
-    for (int i = 0; i <= 750; ++i) {
-        const double beta = 0.25 + 0.005 * i;
-        double mean = 0;
-        for (std::size_t k = 0; k < b.size(); ++k) {
-            mean += std::log(t[k]) - std::log(std::pow(b[k], beta) - 1);
-        }
-        mean /= double(b.size());
-        double residual = 0;
-        for (std::size_t k = 0; k < b.size(); ++k) {
-            const double r = std::log(t[k]) - std::log(std::pow(b[k], beta) - 1) - mean;
-            residual += r * r;
-        }
-        if (residual < best) best = residual, best_beta = beta, best_log = mean;
-    }
-    return {std::exp(best_log), best_beta};
 }
 
 }  // namespace
 
 ErrorSums& ErrorSums::operator+=(const ErrorSums& o) {
-    for (std::size_t k = 0; k < runs.size(); ++k) {
-        runs[k] += o.runs[k];
-        runs_pixels[k] += o.runs_pixels[k];
-    }
+    variance += o.variance;
+    spread += o.spread;
+    pixels += o.pixels;
+    samples += o.samples;
     return *this;
 }
 
-Color pixel_spread(std::span<const Color> samples, SpreadKind kind, ErrorSums& sums) {
+Color pixel_spread(std::span<const Color> samples) {
     constexpr double inf = std::numeric_limits<double>::infinity();
     const std::size_t n = samples.size();
     if (n < 2) return {inf, inf, inf};
-    if (kind != SpreadKind::kProgressive) return sample_variance(samples) / double(n);
-    Color spread{inf, inf, inf};
-    for (std::size_t k = 0; k < kRuns.size() && std::size_t(kRuns[k]) <= n; ++k) {
-        const auto runs = static_cast<std::size_t>(kRuns[k]);
-        std::array<Color, 8> means{};
-        for (std::size_t g = 0; g < runs; ++g) {
-            const std::size_t begin = g * n / runs, end = (g + 1) * n / runs;
-            for (std::size_t i = begin; i < end; ++i) means[g] += samples[i];
-            means[g] = means[g] / double(end - begin);
-        }
-        spread = sample_variance({means.data(), runs}) * (double(runs - 1) / double(runs));
-        sums.runs[k] += sum(spread);
-        sums.runs_pixels[k] += 1;
+    // Welford's update, steady for many similar values.
+    Color mean, m2;
+    for (std::size_t i = 0; i < n; ++i) {
+        const Color delta = samples[i] - mean;
+        mean += delta / double(i + 1);
+        m2 += delta * (samples[i] - mean);
     }
-    return spread;
+    return m2 / (double(n - 1) * double(n));
+}
+
+double calibration_share(double pixels) {
+    return std::clamp(64 / std::max(1.0, pixels), kCalibrationShare, 1.0);
+}
+
+std::vector<double> calibration_odds(const Image& spread, double share) {
+    constexpr double kShared = 0.25;
+    const std::size_t pixels = std::size_t(spread.width) * spread.height;
+    std::vector<double> spreads(pixels);
+    double total = 0;
+    for (std::size_t i = 0; i < pixels; ++i) {
+        spreads[i] = double(spread.rgb[3 * i]) + spread.rgb[3 * i + 1] + spread.rgb[3 * i + 2];
+        total += spreads[i];
+    }
+    std::vector<double> odds(pixels, share);
+    if (!(total > 0) || !std::isfinite(total)) return odds;
+    const double mean = total / double(pixels);
+    for (std::size_t i = 0; i < pixels; ++i) {
+        odds[i] = std::min(1.0, share * (kShared + (1 - kShared) * spreads[i] / mean));
+    }
+    return odds;
+}
+
+void add_calibration(ErrorSums& sums, const Color& first, const Color& second, const Color& spread,
+                     double odds, std::uint32_t samples) {
+    const Color d = first - second;
+    sums.variance += 0.5 * sum(d * d) / odds;
+    sums.spread += sum(spread) / odds;
+    sums.pixels += 1;
+    sums.samples += samples;
 }
 
 ErrorEstimate estimate_error(const Image& image, const Image& spread, const ErrorSums& sums,
-                             int spp, SpreadKind kind) {
+                             std::uint64_t samples, int spp, SpreadKind kind) {
     if (image.width != spread.width || image.height != spread.height) {
         throw ImageError("the spread image is " + std::to_string(spread.width) + "x" +
                          std::to_string(spread.height) + ", the image " +
@@ -93,28 +82,25 @@ ErrorEstimate estimate_error(const Image& image, const Image& spread, const Erro
         e.unavailable = "1 spp takes the pixel centre: no spread to measure";
         return e;
     }
-    const double pixels = double(image.width) * image.height;
-    if (kind == SpreadKind::kProgressive) {
-        std::vector<double> b, t;
-        std::size_t last = 0;
-        for (std::size_t k = 0; k < kRuns.size(); ++k) {
-            if (sums.runs_pixels[k] != pixels) continue;
-            b.push_back(kRuns[k]);
-            t.push_back(sums.runs[k]);
-            last = k;
-        }
-        // Two sizes of run fix the rate exactly and leave its noise unchecked: at 4 spp the
-        // estimate strayed to half the true error (docs/accuracy.md).
-        if (b.size() < 3) {
-            e.unavailable = "the sobol estimate needs 8 spp or more";
+    if (kind == SpreadKind::kCalibrated) {
+        e.cost = samples > 0 ? sums.samples / double(samples) : 0;
+        const bool flat = sums.variance == 0 && std::all_of(spread.rgb.begin(), spread.rgb.end(),
+                                                            [](float v) { return v == 0; });
+        if (flat) {
+            e.scale = 0;
+        } else if (sums.pixels < kMinCalibrationPixels) {
+            std::ostringstream why;
+            why << "the image is too small to calibrate the estimate: " << sums.pixels
+                << " pixels rendered twice, " << kMinCalibrationPixels << " needed";
+            e.unavailable = why.str();
             return e;
-        }
-        if (*std::min_element(t.begin(), t.end()) <= 0) {
-            e.scale = 0;  // no spread at any size: every sample alike
+        } else if (sums.spread > 0) {
+            e.scale = sums.variance / sums.spread;
+        } else if (sums.variance > 0) {
+            e.unavailable = "the pixels rendered twice differ but their samples do not spread";
+            return e;
         } else {
-            const auto [sigma2, beta] = fit_runs(b, t);
-            e.scale = sigma2 / sums.runs[last];
-            e.beta = beta;
+            e.scale = 0;  // the pixels rendered twice alike, and their samples too
         }
     }
     double mse = 0, relmse = 0;
@@ -127,7 +113,7 @@ ErrorEstimate estimate_error(const Image& image, const Image& spread, const Erro
         mse += v;
         relmse += v / (std::max(0.0, x * x - v) + 0.01);
     }
-    const double count = std::max(1.0, 3 * pixels);
+    const double count = std::max(1.0, 3.0 * image.width * image.height);
     e.rmse = std::sqrt(mse / count);
     e.relmse = relmse / count;
     return e;

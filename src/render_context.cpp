@@ -65,8 +65,7 @@ RenderContext::RenderContext(const Scene& scene, std::optional<AdaptiveSampling>
 }
 
 SpreadKind RenderContext::spread_kind() const {
-    if (sampler_->progressive()) return SpreadKind::kProgressive;
-    return sampler_->independent() ? SpreadKind::kIndependent : SpreadKind::kOther;
+    return sampler_->independent() ? SpreadKind::kIndependent : SpreadKind::kCalibrated;
 }
 
 TileBuffer RenderContext::render_tile(const Tile& tile) const {
@@ -75,17 +74,20 @@ TileBuffer RenderContext::render_tile(const Tile& tile) const {
         0};
     buffer.pixel_samples.reserve(static_cast<std::size_t>(tile.width()) * tile.height());
     Scratch scratch;
-    scratch.colors.resize(static_cast<std::size_t>(scene_.settings.samples));
+    std::vector<Pixel> rendered;
+    rendered.reserve(buffer.pixel_samples.capacity());
     for (int y = tile.y0; y < tile.y1; ++y) {
         for (int x = tile.x0; x < tile.x1; ++x) {
-            const Pixel pixel = adaptive_ ? adaptive_pixel(x, y, scratch, buffer)
-                                          : plain_pixel(x, y, scratch, buffer);
+            const Pixel& pixel = rendered.emplace_back(render_pixel(x, y, 0, scratch, buffer.rays));
             buffer.pixels.set(x - tile.x0, y - tile.y0, pixel.value);
             buffer.spread.set(x - tile.x0, y - tile.y0, pixel.spread);
             buffer.pixel_samples.push_back(pixel.samples);
             buffer.samples += pixel.samples;
             buffer.converged += pixel.converged ? 1 : 0;
         }
+    }
+    if (spread_kind() == SpreadKind::kCalibrated && scene_.settings.samples >= 2) {
+        calibrate(tile, rendered, scratch, buffer);
     }
     return buffer;
 }
@@ -109,23 +111,56 @@ std::uint64_t RenderContext::estimate_cost(const Tile& tile) const {
     return pilots == 0 ? 0 : rays.total() * pixels / pilots;
 }
 
-RenderContext::Pixel RenderContext::plain_pixel(int x, int y, Scratch& scratch,
-                                                TileBuffer& buffer) const {
+// The key of the second, independent pattern of a pixel rendered twice: a ray-tree path of its
+// own, which every sampler folds into every number it draws.
+constexpr std::uint64_t kCalibrationPath = 0xca11b4a7e5eedULL;
+
+void RenderContext::calibrate(const Tile& tile, std::span<const Pixel> rendered, Scratch& scratch,
+                              TileBuffer& buffer) const {
+    const std::vector<double> odds = calibration_odds(
+        buffer.spread, calibration_share(double(scene_.settings.width) * scene_.settings.height));
+    // The second renders' rays stay out of the image's ray counts: they are the estimate's cost,
+    // which the sums count in camera samples.
+    RayCounts rays;
+    std::size_t i = 0;
+    for (int y = tile.y0; y < tile.y1; ++y) {
+        for (int x = tile.x0; x < tile.x1; ++x, ++i) {
+            const auto pixel = static_cast<std::uint32_t>(y * scene_.settings.width + x);
+            if (to_unit(hash_of(scene_.settings.seed, pixel, kCalibrationPath)) >= odds[i]) {
+                continue;
+            }
+            const Pixel again = render_pixel(x, y, kCalibrationPath, scratch, rays);
+            add_calibration(buffer.error_sums, rendered[i].value, again.value, rendered[i].spread,
+                            odds[i], again.samples);
+        }
+    }
+}
+
+RenderContext::Pixel RenderContext::render_pixel(int x, int y, std::uint64_t path, Scratch& scratch,
+                                                 RayCounts& rays) const {
+    return adaptive_ ? adaptive_pixel(x, y, path, scratch, rays)
+                     : plain_pixel(x, y, path, scratch, rays);
+}
+
+RenderContext::Pixel RenderContext::plain_pixel(int x, int y, std::uint64_t path, Scratch& scratch,
+                                                RayCounts& rays) const {
     const auto spp = static_cast<std::uint32_t>(scene_.settings.samples);
     const PixelSample s{scene_.settings.seed,
-                        static_cast<std::uint32_t>(y * scene_.settings.width + x), 0, spp};
-    integrator_.sample_pixel(x, y, s, scratch.colors, buffer.rays);
+                        static_cast<std::uint32_t>(y * scene_.settings.width + x), 0, spp, path};
+    scratch.colors.resize(spp);
+    integrator_.sample_pixel(x, y, s, scratch.colors, rays);
     Color sum;
     for (const Color& c : scratch.colors) sum += c;
-    return {sum / spp, pixel_spread(scratch.colors, spread_kind(), buffer.error_sums), spp, false};
+    return {sum / spp, pixel_spread(scratch.colors), spp, false};
 }
 
 // Rounds of as many samples as taken so far, until the standard error of the mean luminance is
 // below the threshold. A progressive sampler continues one pattern; any other starts a new
 // pattern of the round's size, on its own ray-tree path, in each round (the first round is
-// exactly a plain render at the minimum count).
-RenderContext::Pixel RenderContext::adaptive_pixel(int x, int y, Scratch& scratch,
-                                                   TileBuffer& buffer) const {
+// exactly a plain render at the minimum count). A second render for the calibration (`path`
+// not 0) does all that on paths of its own.
+RenderContext::Pixel RenderContext::adaptive_pixel(int x, int y, std::uint64_t path,
+                                                   Scratch& scratch, RayCounts& rays) const {
     const auto spp = static_cast<std::uint32_t>(scene_.settings.samples);
     const auto min_spp = static_cast<std::uint32_t>(adaptive_->min_samples);
     const auto pixel = static_cast<std::uint32_t>(y * scene_.settings.width + x);
@@ -138,11 +173,13 @@ RenderContext::Pixel RenderContext::adaptive_pixel(int x, int y, Scratch& scratc
     for (std::uint32_t round = 0;; ++round) {
         const auto n = static_cast<std::uint32_t>(luminances.size());
         const std::uint32_t batch = std::min(round == 0 ? min_spp : n, spp - n);
-        PixelSample s{scene_.settings.seed, pixel, 0, progressive ? spp : batch};
-        if (!progressive && round > 0) s.path = hash_of(0xada9717eULL, round);
+        PixelSample s{scene_.settings.seed, pixel, 0, progressive ? spp : batch, path};
+        if (!progressive && round > 0) {
+            s.path = path == 0 ? hash_of(0xada9717eULL, round) : hash_of(path, round);
+        }
         s.index = progressive ? n : 0;
         scratch.colors.resize(batch);
-        integrator_.sample_pixel(x, y, s, scratch.colors, buffer.rays);
+        integrator_.sample_pixel(x, y, s, scratch.colors, rays);
         for (const Color& c : scratch.colors) {
             sum += c;
             luminances.push_back(luminance(c));
@@ -155,7 +192,7 @@ RenderContext::Pixel RenderContext::adaptive_pixel(int x, int y, Scratch& scratc
         }
     }
     const auto n = static_cast<std::uint32_t>(luminances.size());
-    return {sum / n, pixel_spread(scratch.taken, spread_kind(), buffer.error_sums), n, converged};
+    return {sum / n, pixel_spread(scratch.taken), n, converged};
 }
 
 std::vector<Tile> costly_first(const RenderContext& context, std::vector<Tile> tiles, int workers) {

@@ -111,7 +111,7 @@ RenderResult assembled(const RenderContext& context, const ImageSink& sink) {
     result.spread = sink.spread();
     if (result.unfinished.empty()) {
         result.stats.error =
-            estimate_error(result.image, result.spread, sink.error_sums(),
+            estimate_error(result.image, result.spread, sink.error_sums(), sink.samples(),
                            context.scene().settings.samples, context.spread_kind());
     } else {
         result.stats.error.unavailable = "the render is unfinished";

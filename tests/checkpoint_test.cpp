@@ -46,8 +46,7 @@ TileBuffer some_tile(const Tile& tile, float base) {
     t.pixel_samples.assign(static_cast<std::size_t>(tile.width()) * tile.height(), 5);
     t.spread = Image(tile.width(), tile.height());
     for (std::size_t i = 0; i < t.spread.rgb.size(); ++i) t.spread.rgb[i] = base * 1e-3f + float(i);
-    t.error_sums.runs = {0.1 + base, 1e-300, 3.5};
-    t.error_sums.runs_pixels = {12, 13, 0};
+    t.error_sums = {0.1 + base, 1e-300, 12, 3.5};
     t.rays = {11, 22, 33, 44};
     t.samples = 5 * t.pixel_samples.size();
     t.converged = 3;
@@ -285,7 +284,7 @@ TEST_F(CheckpointCli, DamagedTruncatedAndForeignCheckpointsExitTwoAndChangeNothi
     format2[7] = '2';
     const std::vector<std::pair<std::string, std::string>> cases{
         {format2,
-         "checkpoint format 2 of another drt version, this one reads format 3: not resumed and "
+         "checkpoint format 2 of another drt version, this one reads format 4: not resumed and "
          "nothing written (delete it or name another --checkpoint file)"},
         {damaged, "checksum does not match"},
         {good.substr(0, good.size() - 100), "checksum does not match"},

@@ -17,56 +17,58 @@
 namespace drt {
 namespace {
 
-TEST(PixelSpread, IndependentSamplesGiveTheSampleVarianceOverN) {
+TEST(PixelSpread, IsTheSampleVarianceOverN) {
     const std::vector<Color> samples{{1, 0, 2}, {3, 0, 2}, {5, 0, 2}, {7, 0, 2}};
-    ErrorSums sums;
-    const Color s = pixel_spread(samples, SpreadKind::kIndependent, sums);
+    const Color s = pixel_spread(samples);
     EXPECT_DOUBLE_EQ(s.r, (20.0 / 3) / 4);  // sample variance of 1, 3, 5, 7 is 20/3
     EXPECT_EQ(s.g, 0);
     EXPECT_EQ(s.b, 0);
-    EXPECT_EQ(sums, ErrorSums{});  // only progressive samples add to the sums
-}
-
-TEST(PixelSpread, ProgressiveSamplesGiveTheSpreadsOfRunMeans) {
-    // Run means: 2 runs {2.5, 6.5}; 4 runs {1.5, 3.5, 5.5, 7.5}; 8 runs 1..8.
-    std::vector<Color> samples;
-    for (int i = 1; i <= 8; ++i) samples.push_back({double(i), 0, 0});
-    ErrorSums sums;
-    const Color s = pixel_spread(samples, SpreadKind::kProgressive, sums);
-    // (B-1)/B x sample variance = mean squared deviation of the B run means.
-    EXPECT_DOUBLE_EQ(sums.runs[0], 4.0);   // deviations of 2
-    EXPECT_DOUBLE_EQ(sums.runs[1], 5.0);   // (9 + 1 + 1 + 9) / 4
-    EXPECT_DOUBLE_EQ(sums.runs[2], 5.25);  // (49 + 25 + 9 + 1) * 2 / 4 / 8
-    EXPECT_EQ(s.r, sums.runs[2]);          // the pixel keeps the most runs' spread
-    EXPECT_EQ(sums.runs_pixels, (std::array<double, 3>{1, 1, 1}));
 }
 
 TEST(PixelSpread, OneSampleHasNoSpread) {
-    ErrorSums sums;
     const std::vector<Color> one{{1, 1, 1}};
-    EXPECT_TRUE(std::isinf(pixel_spread(one, SpreadKind::kOther, sums).r));
+    EXPECT_TRUE(std::isinf(pixel_spread(one).r));
 }
 
-TEST(EstimateError, OneSampleAndTooFewRunsAreNotANumber) {
+TEST(CalibrationOdds, AQuarterSharedAndTheRestByTheSpread) {
+    Image spread(4, 1);
+    spread.rgb = {0, 0, 0, 1, 1, 1, 0.5f, 0.25f, 0.25f, 1, 0.5f, 0.5f};  // sums 0, 3, 1, 2
+    const double f = 0.1;
+    const std::vector<double> odds = calibration_odds(spread, f);
+    ASSERT_EQ(odds.size(), 4u);
+    EXPECT_DOUBLE_EQ(odds[0], f * 0.25);
+    EXPECT_DOUBLE_EQ(odds[1], f * (0.25 + 0.75 * 3 / 1.5));
+    EXPECT_DOUBLE_EQ(odds[2], f * (0.25 + 0.75 * 1 / 1.5));
+    EXPECT_DOUBLE_EQ(odds[3], f * (0.25 + 0.75 * 2 / 1.5));
+    // No spread anywhere: the same odds everywhere.
+    EXPECT_EQ(calibration_odds(Image(2, 2), f), std::vector<double>(4, f));
+    // At least 64 pixels of an image, or all of them.
+    EXPECT_EQ(calibration_share(10000), kCalibrationShare);
+    EXPECT_EQ(calibration_share(640), 0.1);
+    EXPECT_EQ(calibration_share(40), 1);
+}
+
+TEST(EstimateError, OneSampleAndTooFewCalibratedPixelsAreNotANumber) {
     const Image image(2, 1), spread(2, 1);
-    const ErrorEstimate one = estimate_error(image, spread, {}, 1, SpreadKind::kOther);
+    const ErrorEstimate one = estimate_error(image, spread, {}, 2, 1, SpreadKind::kCalibrated);
     EXPECT_FALSE(one.available());
     EXPECT_EQ(one.unavailable, "1 spp takes the pixel centre: no spread to measure");
     EXPECT_EQ(format_estimate(one.rmse, one.unavailable),
               "n/a (1 spp takes the pixel centre: no spread to measure)");
-    ErrorSums two_runs;
-    two_runs.runs = {1, 0, 0};
-    two_runs.runs_pixels = {2, 0, 0};
-    const ErrorEstimate sobol =
-        estimate_error(image, spread, two_runs, 2, SpreadKind::kProgressive);
-    EXPECT_EQ(sobol.unavailable, "the sobol estimate needs 8 spp or more");
+    ErrorSums few;
+    few.pixels = kMinCalibrationPixels - 1;
+    few.spread = few.variance = 1;
+    const ErrorEstimate small = estimate_error(image, spread, few, 8, 4, SpreadKind::kCalibrated);
+    EXPECT_EQ(small.unavailable,
+              "the image is too small to calibrate the estimate: 23 pixels rendered twice, 24 "
+              "needed");
 }
 
 TEST(EstimateError, IndependentSpreadsAverageOverPixelsAndChannels) {
     Image image(2, 1), spread(2, 1);
     image.rgb = {0.5f, 0.5f, 0.5f, 0, 0, 0};
     spread.rgb = {0.01f, 0.02f, 0.03f, 0.04f, 0.05f, 0.06f};
-    const ErrorEstimate e = estimate_error(image, spread, {}, 16, SpreadKind::kIndependent);
+    const ErrorEstimate e = estimate_error(image, spread, {}, 32, 16, SpreadKind::kIndependent);
     ASSERT_TRUE(e.available());
     EXPECT_NEAR(*e.rmse, std::sqrt(0.21 / 6), 1e-7);
     // relMSE: v / (max(0, x^2 - v) + 0.01).
@@ -75,23 +77,26 @@ TEST(EstimateError, IndependentSpreadsAverageOverPixelsAndChannels) {
     EXPECT_NEAR(*e.relmse, rel / 6, 1e-6);
 }
 
-TEST(EstimateError, ProgressiveFitFindsTheRateAndTheVariance) {
-    // Spreads made exactly as E[T_B] = sigma2 (B^beta - 1) says, for beta 1 (random noise), 1.5
-    // (edges) and 3 (smooth).
-    for (const double beta : {1.0, 1.5, 3.0}) {
-        const double sigma2 = 0.003;  // summed over 1 pixel x 3 channels
-        ErrorSums sums;
-        for (std::size_t k = 0; k < 3; ++k) {
-            sums.runs[k] = sigma2 * (std::pow(2.0 * (1 << k), beta) - 1);
-            sums.runs_pixels[k] = 1;
-        }
-        Image image(1, 1), spread(1, 1);
-        spread.rgb = {float(sums.runs[2] / 3), float(sums.runs[2] / 3), float(sums.runs[2] / 3)};
-        const ErrorEstimate e = estimate_error(image, spread, sums, 64, SpreadKind::kProgressive);
-        ASSERT_TRUE(e.available());
-        EXPECT_NEAR(e.beta, beta, 0.003);
-        EXPECT_NEAR(*e.rmse, std::sqrt(sigma2 / 3), 0.01 * std::sqrt(sigma2 / 3)) << beta;
-    }
+TEST(EstimateError, CalibrationScalesEverySpread) {
+    // Two pixels rendered twice: one with odds 1/2 whose means differ by (0.2, 0, 0) and spread
+    // 0.01 in red, one with odds 1/4, the same means and spread 0.02 in each channel: variance
+    // 2 * 0.04 / 2 = 0.04 against spread 2 * 0.01 + 4 * 0.06 = 0.26. A pixel of spread 0.26 per
+    // channel then has the variance 0.04 per channel.
+    ErrorSums sums;
+    add_calibration(sums, {0.5, 0.5, 0.5}, {0.3, 0.5, 0.5}, {0.01, 0, 0}, 0.5, 16);
+    add_calibration(sums, {0.1, 0.1, 0.1}, {0.1, 0.1, 0.1}, {0.02, 0.02, 0.02}, 0.25, 16);
+    EXPECT_DOUBLE_EQ(sums.variance, 0.04);
+    EXPECT_DOUBLE_EQ(sums.spread, 0.02 + 0.24);
+    EXPECT_EQ(sums.pixels, 2);
+    EXPECT_EQ(sums.samples, 32);
+    sums.pixels = kMinCalibrationPixels;
+    Image image(1, 1), spread(1, 1);
+    spread.rgb = {0.26f, 0.26f, 0.26f};
+    const ErrorEstimate e = estimate_error(image, spread, sums, 320, 16, SpreadKind::kCalibrated);
+    ASSERT_TRUE(e.available());
+    EXPECT_DOUBLE_EQ(e.scale, 0.04 / 0.26);
+    EXPECT_NEAR(*e.rmse, std::sqrt(0.04), 1e-7);
+    EXPECT_DOUBLE_EQ(e.cost, 0.1);
 }
 
 Scene small_scene(const std::string& file, const std::string& sampler, int spp,

@@ -94,6 +94,15 @@ std::string rays_of(const fs::path& json) {
                                    : text.substr(at, text.find('}', at) - at);
 }
 
+// The image's own error estimate in a --stats file ("estimated_rmse": ... to the line's end), as
+// text: a sum over tiles that must not depend on who rendered them.
+std::string estimate_of(const fs::path& json) {
+    const std::string text = read_bytes(json);
+    const std::size_t at = text.find("\"estimated_rmse\"");
+    return at == std::string::npos ? "no estimate in " + text
+                                   : text.substr(at, text.find('\n', at) - at);
+}
+
 class MpiCli : public ::testing::Test {
   protected:
     void SetUp() override {
@@ -152,6 +161,8 @@ TEST_P(MpiProcessesAndThreads, AdaptiveRenderIsTheSingleProcesssBitsAndRayCounts
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(bytes("mpi.pfm"), bytes("plain.pfm"));
     EXPECT_EQ(rays_of(dir_ / "mpi.json"), rays_of(dir_ / "plain.json"));
+    EXPECT_EQ(estimate_of(dir_ / "mpi.json"), estimate_of(dir_ / "plain.json"));
+    EXPECT_NE(estimate_of(dir_ / "mpi.json").find("\"estimated_rmse\": 0."), std::string::npos);
     EXPECT_NE(bytes("mpi.json").find("\"processes\": " + std::to_string(processes)),
               std::string::npos);
     EXPECT_EQ(r.out + r.err, "");  // -q: nothing from any process
@@ -227,6 +238,7 @@ TEST_F(MpiCli, StoppedUnderOneSplitResumedUnderAnotherGivesTheSameBits) {
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(bytes("out.pfm"), bytes("plain.pfm"));
     EXPECT_EQ(rays_of(dir_ / "out.json"), rays_of(dir_ / "plain.json"));
+    EXPECT_EQ(estimate_of(dir_ / "out.json"), estimate_of(dir_ / "plain.json"));
 }
 
 TEST_F(MpiCli, ForeignCheckpointIsRefusedByEveryProcessWithOneMessage) {

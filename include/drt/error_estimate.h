@@ -2,51 +2,72 @@
 // pixel's mean is expected to lie from the converged value, and what that makes of the image's
 // RMSE and relative MSE (the measures drt converge takes against a reference, converge.h).
 //
-// Each pixel keeps a spread of its samples, per channel (TileBuffer::spread), and adds to a few
-// sums over its tile (TileBuffer::error_sums); both are pure functions of the pixel like its
-// value, so they are the same for any threads, tile order, process or resume. The image's
-// estimate (estimate_error) turns the sums, added up in tile order, into one scale that makes
-// every pixel's spread the variance of its mean.
+// Each pixel keeps the spread of its samples, per channel: their sample variance over n
+// (pixel_spread). For independent samples (the random sampler) that is the variance of the
+// pixel's mean. For a stratified or Sobol pattern it is not: it ignores the stratification and
+// overstated the error by 1.3 to 10x (docs/accuracy.md). There the spread only says where the
+// error is, and the image calibrates how large it is: a few pixels of each tile, chosen at random
+// with odds that grow with their spread (calibration_odds), are rendered a second time with an
+// independent pattern of the same sampler and count. Half the squared difference of the two
+// means has the variance of the mean as its expectation, whatever the pattern; summed over the
+// chosen pixels, each weighted by 1 / its odds, against the same weighted sum of their spreads,
+// it gives the factor (`scale`) that turns every pixel's spread into the variance of its mean.
+// The second renders only calibrate: the image is the first render's, unchanged.
 //
-// How the spread is made depends on the sampler (SpreadKind):
-// - independent samples: the sample variance over n is the variance of the mean, scale 1.
-// - a progressive sampler (sobol): its samples split into B consecutive runs that are each a
-//   stratified pattern of their own and exchangeable, and then E[spread of the B run means] =
-//   B/(B-1) (var of a run's mean - var of the whole mean). With var(mean of n/B) = var(mean of n)
-//   * B^beta, the spreads at B = 2, 4, 8 give beta (the image's convergence rate: 1 for random
-//   noise, 1.5 at edges, more where smooth) and the variance. Plain batch means (beta = 1) would
-//   overstate the error of a stratified pattern by up to B^((beta-1)/2).
-// - any other sampler: the sample variance over n, scale 1, which overstates stratified samples.
+// The spreads and the tile's sums are pure functions of the tile like its pixels, so they are
+// the same for any threads, tile order, process or resume; the image's estimate adds the tiles'
+// sums up in tile order.
 #pragma once
 
-#include <array>
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "drt/color.h"
 #include "drt/image.h"
 
 namespace drt {
 
-enum class SpreadKind { kIndependent, kProgressive, kOther };
+// kIndependent: the spread is the variance of the mean. kCalibrated: a stratified or Sobol pattern,
+// calibrated by second renders.
+enum class SpreadKind { kIndependent, kCalibrated };
 
-// What the image's estimate adds up over all pixels and channels.
+// The share of an image's pixels rendered a second time, on average: the calibration's cost.
+inline constexpr double kCalibrationShare = 0.08;
+// Fewer pixels rendered twice than this leave the calibration too noisy to state a number.
+inline constexpr double kMinCalibrationPixels = 24;
+// The share for an image of `pixels` pixels: kCalibrationShare, or more for a small image, so
+// that 64 pixels are rendered twice on average (all of them below 64).
+double calibration_share(double pixels);
+
+// What the image's estimate adds up over the pixels rendered twice (kCalibrated).
 struct ErrorSums {
-    // Progressive: (B-1)/B x the sample variance of the means of B consecutive runs, for B = 2, 4,
-    // 8, and the pixels that had samples for each B (B at most the pixel's count).
-    std::array<double, 3> runs{};
-    std::array<double, 3> runs_pixels{};
+    double variance = 0;  // half the squared difference of the two means, over channels, / odds
+    double spread = 0;    // the first render's spread, summed over channels, / odds
+    double pixels = 0;    // how many pixels were rendered twice
+    double samples = 0;   // the camera samples that took
 
     ErrorSums& operator+=(const ErrorSums& o);
     friend bool operator==(const ErrorSums&, const ErrorSums&) = default;
 };
 
-// One pixel's samples (in the order taken) as the estimate uses them: `spread`, per channel, is
-// the sample variance over n (independent, other) or the (B-1)/B-scaled spread of the means of
-// the most runs B <= 8 (progressive); infinite for fewer than two samples. `sums` gets the
-// pixel's share.
-Color pixel_spread(std::span<const Color> samples, SpreadKind kind, ErrorSums& sums);
+// The sample variance of one pixel's samples over their count, per channel; infinite for fewer
+// than two samples.
+Color pixel_spread(std::span<const Color> samples);
+
+// For each pixel of a tile (its spread image, row by row), the odds of rendering it a second
+// time: `share` on average over the tile, a quarter of them shared equally and the rest in
+// proportion to the pixel's spread, at most 1. Pixels where the samples spread more
+// carry most of the error, so the calibration looks there most often; every pixel keeps some
+// odds, so the weighted sums stay unbiased.
+std::vector<double> calibration_odds(const Image& spread, double share);
+
+// Adds a pixel rendered twice: `first` the image's mean and `spread` its spread, `second` the
+// mean of the independent render of `samples` camera samples, `odds` its calibration odds.
+void add_calibration(ErrorSums& sums, const Color& first, const Color& second, const Color& spread,
+                     double odds, std::uint32_t samples);
 
 struct ErrorEstimate {
     // Both present, or neither: then `unavailable` says why.
@@ -55,19 +76,20 @@ struct ErrorEstimate {
     std::string unavailable;
     // A pixel's spread times `scale` is the estimated variance of its mean (when available).
     double scale = 1;
-    // Progressive: the fitted convergence rate beta (variance of the mean ~ n^-beta); 1 otherwise.
-    double beta = 1;
+    // The camera samples the calibration took, over the image's: its cost.
+    double cost = 0;
 
     bool available() const { return rmse.has_value(); }
 };
 
 // The expected RMSE and relative MSE of `image` against the converged image from the per-pixel
-// spreads (the same size) and the image's sums. relMSE stands x^2 - variance (at least 0) for
-// the unknown ref^2. `spp` is the samples per pixel asked for: with 1 the pixel centre is taken
-// and nothing can be estimated, and a progressive sampler needs 8 (three sizes of run). Throws
+// spreads (the same size), the image's sums and its camera `samples`. relMSE stands x^2 -
+// variance (at least 0) for the unknown ref^2. `spp` is the samples per pixel asked for: with 1
+// the pixel centre is taken and nothing can be estimated. Where no sample of any pixel spread and
+// no pixel rendered twice differed, the estimate is 0 however few were rendered twice. Throws
 // ImageError when the sizes differ.
 ErrorEstimate estimate_error(const Image& image, const Image& spread, const ErrorSums& sums,
-                             int spp, SpreadKind kind);
+                             std::uint64_t samples, int spp, SpreadKind kind);
 
 // The per-pixel standard error, per channel: sqrt(spread x scale); 0 where there is no estimate.
 Image standard_error_image(const Image& spread, const ErrorEstimate& estimate);

@@ -75,9 +75,16 @@ class RenderContext {
         std::vector<double> luminances;
     };
 
-    // Both add their rays and error sums to `buffer`.
-    Pixel plain_pixel(int x, int y, Scratch& scratch, TileBuffer& buffer) const;
-    Pixel adaptive_pixel(int x, int y, Scratch& scratch, TileBuffer& buffer) const;
+    // One pixel on ray-tree path `path` (0 for the image's own render), adaptively or not; they
+    // add their rays to `rays`.
+    Pixel render_pixel(int x, int y, std::uint64_t path, Scratch& scratch, RayCounts& rays) const;
+    Pixel plain_pixel(int x, int y, std::uint64_t path, Scratch& scratch, RayCounts& rays) const;
+    Pixel adaptive_pixel(int x, int y, std::uint64_t path, Scratch& scratch, RayCounts& rays) const;
+    // Renders some of the tile's pixels a second time for the error estimate (error_estimate.h)
+    // and adds them to the buffer's error sums; `rendered` are the tile's pixels, row
+    // by row.
+    void calibrate(const Tile& tile, std::span<const Pixel> rendered, Scratch& scratch,
+                   TileBuffer& buffer) const;
 
     const Scene& scene_;
     std::unique_ptr<Sampler> sampler_;
