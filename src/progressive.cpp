@@ -19,7 +19,9 @@ using Clock = std::chrono::steady_clock;
 // on, and a round a sixteenth of the next costs little.
 constexpr double kMaxGrowth = 16;
 // A pilot at least this many times the last round's count: a narrower span measures no slope.
-constexpr int kMinPilotGrowth = 3;
+constexpr int kMinPilotGrowth = 4;
+// A slope only from rounds at least this many times apart: a narrower span measures noise.
+constexpr int kMinSlopeSpan = 3;
 // The error's log-log slope against samples for independent samples.
 constexpr double kIndependentSlope = -0.5;
 // Of the time left, what a round may be predicted to take: the rest absorbs the prediction's
@@ -85,10 +87,10 @@ std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, d
     if (measured.empty()) return std::nullopt;
     const ProgressiveRound& b = *measured.back();
     double slope = kIndependentSlope;
-    // The latest earlier round kMinPilotGrowth times fewer: over a narrower span (a final round
+    // The latest earlier round kMinSlopeSpan times fewer: over a narrower span (a final round
     // that just missed after one only a little smaller) the errors' noise decides the slope.
     const auto a = std::find_if(measured.rbegin() + 1, measured.rend(),
-                                [&](const auto* r) { return r->spp * kMinPilotGrowth <= b.spp; });
+                                [&](const auto* r) { return r->spp * kMinSlopeSpan <= b.spp; });
     if (a != measured.rend()) {
         slope = std::clamp(std::log(*b.error / *(*a)->error) / std::log(double(b.spp) / (*a)->spp),
                            -1.0, -0.25);

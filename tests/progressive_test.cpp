@@ -96,16 +96,16 @@ TEST(NextRound, APilotATwelfthOfAPredictionFurtherAway) {
     EXPECT_FALSE(n.final);
     // From the first pilot alone (slope -1/2): 8 * 400 * 1.1 = 3520 -> a pilot of 294.
     EXPECT_EQ(next_round({{8, 1.0, 0.2}}, 0.01, 65536).spp, 294);
-    // A twelfth that is less than 3 times the last round is raised to 3 times: 32 * 16 * 1.1 =
-    // 563.2 -> 564, a twelfth 47, raised to 96.
-    EXPECT_EQ(next_round(rounds, 0.01, 65536).spp, 96);
+    // A twelfth that is less than 4 times the last round is raised to 4 times: 32 * 16 * 1.1 =
+    // 563.2 -> 564, a twelfth 47, raised to 128.
+    EXPECT_EQ(next_round(rounds, 0.01, 65536).spp, 128);
 }
 
-TEST(NextRound, AtLeastAQuarterMoreAndThreeTimesWithoutAnEstimate) {
+TEST(NextRound, AtLeastAQuarterMoreAndFourTimesWithoutAnEstimate) {
     // Just over the target: 100 * 1.1 would be 110, raised to 125.
     EXPECT_EQ(next_round({{50, 1, 0.02}, {100, 2, 0.0100001}}, 0.01, 65536).spp, 125);
     const NextRound blind = next_round({{8, 1, std::nullopt}}, 0.01, 65536);
-    EXPECT_EQ(blind.spp, 24);
+    EXPECT_EQ(blind.spp, 32);
     EXPECT_FALSE(blind.final);
 }
 

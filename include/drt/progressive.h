@@ -54,9 +54,9 @@ double predicted_seconds(const std::vector<ProgressiveRound>& rounds, int spp);
 
 // The count of the round after `rounds` on the way to `target` (at most `max_samples`, 0 when
 // the target is met or max_samples reached): the predicted count itself when it is at most
-// kFinalStep times the last round's (`final`), otherwise a pilot a kFinalStep-th of it, whose
-// error against the last round's measures the slope over a wide span, so that the next
-// prediction extrapolates only kFinalStep-fold and lands on the count in one step.
+// kFinalStep times the last round's (`final`), otherwise a pilot a kFinalStep-th of it (at least 4
+// times the last round), whose error against the last round's measures the slope over a wide span,
+// so that the next prediction extrapolates only kFinalStep-fold and lands on the count in one step.
 struct NextRound {
     int spp = 0;
     bool final = false;
