@@ -111,7 +111,9 @@ Scene small_scene(const std::string& file, const std::string& sampler, int spp,
 }
 
 // The estimate against the error measured against a 4096-spp sobol reference (its own error,
-// 1/64 of the renders' variance or less, taken out), for three seeds.
+// 1/64 of the renders' variance or less, taken out), for every sampler and three seeds. The
+// sample variance over n without the calibration (the stratified estimate before it) overstates
+// the stratified and sobol errors here 3.5-3.7x, which the test checks so that it keeps telling.
 TEST(EstimateError, WithinAQuarterOfTheTrueErrorOnAPenumbraAndEdges) {
     RenderOptions options;
     options.threads = 2;
@@ -119,13 +121,19 @@ TEST(EstimateError, WithinAQuarterOfTheTrueErrorOnAPenumbraAndEdges) {
         render(small_scene("study/penumbra.xml", "sobol", 4096, 100), options);
     ASSERT_TRUE(reference.stats.error.available());
     const double ref_mse = std::pow(*reference.stats.error.rmse, 2);
-    for (const std::string sampler : {"sobol", "random"}) {
+    for (const std::string sampler : {"stratified", "sobol", "random"}) {
         for (const std::uint64_t seed : {1, 2, 3}) {
             const RenderResult r =
                 render(small_scene("study/penumbra.xml", sampler, 64, seed), options);
             ASSERT_TRUE(r.stats.error.available());
             const double truth = std::sqrt(std::pow(rmse(r.image, reference.image), 2) - ref_mse);
             const double ratio = *r.stats.error.rmse / truth;
+            double spread = 0;
+            for (const float v : r.spread.rgb) spread += v;
+            const double uncalibrated = std::sqrt(spread / double(r.spread.rgb.size())) / truth;
+            if (sampler != "random") {
+                EXPECT_GT(uncalibrated, 3) << sampler << " seed " << seed;
+            }
             EXPECT_GT(ratio, 0.8) << sampler << " seed " << seed;
             EXPECT_LT(ratio, 1.25) << sampler << " seed " << seed;
         }
