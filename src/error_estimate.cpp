@@ -40,7 +40,8 @@ Color pixel_spread(std::span<const Color> samples) {
 }
 
 double calibration_share(double pixels) {
-    return std::clamp(64 / std::max(1.0, pixels), kCalibrationShare, 1.0);
+    const double n = std::max(1.0, pixels);
+    return std::min(1.0, std::max(64 / n, std::min(kCalibrationShare, kMaxCalibrationPixels / n)));
 }
 
 std::vector<double> calibration_odds(const Image& spread, double share) {

@@ -42,10 +42,13 @@ TEST(CalibrationOdds, AQuarterSharedAndTheRestByTheSpread) {
     EXPECT_DOUBLE_EQ(odds[3], f * (0.25 + 0.75 * 2 / 1.5));
     // No spread anywhere: the same odds everywhere.
     EXPECT_EQ(calibration_odds(Image(2, 2), f), std::vector<double>(4, f));
-    // At least 64 pixels of an image, or all of them.
+    // 8 % of an image, but at least 64 pixels, or all of them.
     EXPECT_EQ(calibration_share(10000), kCalibrationShare);
     EXPECT_EQ(calibration_share(640), 0.1);
     EXPECT_EQ(calibration_share(40), 1);
+    // Not more than 4096 pixels of a large one.
+    EXPECT_EQ(calibration_share(51200), kCalibrationShare);
+    EXPECT_DOUBLE_EQ(calibration_share(800 * 600) * 800 * 600, 4096);
 }
 
 TEST(EstimateError, OneSampleAndTooFewCalibratedPixelsAreNotANumber) {
