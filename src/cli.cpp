@@ -351,6 +351,9 @@ struct RenderJob {
     bool quiet = false;
     bool progress = false;
     bool exr_half = false;
+    // Something shows the error estimate besides an .exr output's attributes (render_one adds
+    // those): the finish line, --stats, --error-image, a goal, a report.
+    bool estimate_shown = true;
     std::string checkpoint;   // a file, or with several scenes a folder of <scene>.checkpoint
     std::string error_image;  // one scene only: where its per-pixel standard error goes
     double checkpoint_seconds = 30;
@@ -505,6 +508,7 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
     options.checkpoint_interval = std::chrono::duration<double>(job.checkpoint_seconds);
     options.stop_after_tiles = job.stop_after_tiles;
     options.costly_first = !job.grid_order;
+    options.estimate_error = job.estimate_shown || format_for_path(output) == ImageFormat::kExr;
     options.stop = job.stop;
     options.mpi = job.mpi;
     std::optional<ProgressDisplay> display;
@@ -782,6 +786,8 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
     }
     if (job.agree(kOk) != kOk) return kBadInput;
     job.progress = !job.quiet && (force_progress || isatty(STDERR_FILENO));
+    job.estimate_shown = !job.quiet || !stats.empty() || !job.error_image.empty() ||
+                         job.goal.wanted() || report.wanted;
 
     const bool batch = scenes.size() > 1 || is_folder_target(output);
     if (batch && !job.error_image.empty()) {

@@ -51,13 +51,15 @@ std::unique_ptr<Sampler> sampler_named(const std::string& name) {
 
 }  // namespace
 
-RenderContext::RenderContext(const Scene& scene, std::optional<AdaptiveSampling> adaptive)
+RenderContext::RenderContext(const Scene& scene, std::optional<AdaptiveSampling> adaptive,
+                             bool estimate_error)
     : scene_(scene),
       sampler_(sampler_named(scene.settings.sampler)),
       plan_(plan_render(scene)),
       bvh_(scene.objects),
       integrator_(scene, plan_, bvh_, *sampler_),
       adaptive_(adaptive),
+      estimate_error_(estimate_error),
       tiles_(tile_grid(scene.settings.width, scene.settings.height)) {
     if (adaptive_) {
         adaptive_->min_samples = std::clamp(adaptive_->min_samples, 1, scene.settings.samples);
@@ -86,7 +88,8 @@ TileBuffer RenderContext::render_tile(const Tile& tile) const {
             buffer.converged += pixel.converged ? 1 : 0;
         }
     }
-    if (spread_kind() == SpreadKind::kCalibrated && scene_.settings.samples >= 2) {
+    if (estimate_error_ && spread_kind() == SpreadKind::kCalibrated &&
+        scene_.settings.samples >= 2) {
         calibrate(tile, rendered, scratch, buffer);
     }
     return buffer;

@@ -37,7 +37,8 @@ class StopAfter final : public TileSink {
 
 RenderJobResult run_render_job(const Scene& scene, const RenderJobOptions& options) {
     const auto start = std::chrono::steady_clock::now();
-    const RenderContext context(scene, options.adaptive);
+    const RenderContext context(scene, options.adaptive,
+                                options.estimate_error || options.checkpoint.has_value());
     const bool leader = options.mpi == nullptr || options.mpi->leader();
     RenderJobResult out;
     out.tiles = context.tiles().size();

@@ -1,5 +1,6 @@
 // The cost guess that orders the tiles: rays a pilot traces, scaled to the tile, and the order
-// it gives (which changes no pixel: renderer_test.cpp renders tiles in any order).
+// it gives (which changes no pixel: renderer_test.cpp renders tiles in any order); a render
+// without its error estimate.
 #include "drt/render_context.h"
 
 #include <gtest/gtest.h>
@@ -58,6 +59,23 @@ TEST(CostlyFirst, LeavesOneWorkersTilesAlone) {
     const Scene scene = mirror_ball();
     const RenderContext context(scene, std::nullopt);
     EXPECT_EQ(costly_first(context, context.tiles(), 1), context.tiles());
+}
+
+TEST(RenderContext, WithoutTheEstimateRendersTheSamePixelsAndNoneTwice) {
+    Scene scene = mirror_ball();
+    scene.settings.samples = 4;  // the stratified sampler: calibrated by second renders
+    const RenderContext with(scene, std::nullopt);
+    const RenderContext without(scene, std::nullopt, false);
+    ErrorSums calibrated;
+    for (const Tile& tile : with.tiles()) {
+        const TileBuffer a = with.render_tile(tile);
+        const TileBuffer b = without.render_tile(tile);
+        EXPECT_EQ(a.pixels.rgb, b.pixels.rgb) << tile.index;
+        EXPECT_EQ(a.rays.total(), b.rays.total()) << tile.index;
+        EXPECT_EQ(b.error_sums, ErrorSums{}) << tile.index;
+        calibrated += a.error_sums;
+    }
+    EXPECT_GE(calibrated.pixels, 64);  // a small image: at least 64 pixels rendered twice
 }
 
 }  // namespace

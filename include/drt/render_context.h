@@ -32,8 +32,10 @@ struct AdaptiveSampling {
 
 class RenderContext {
   public:
-    // Throws std::invalid_argument for an unknown sampler name.
-    RenderContext(const Scene& scene, std::optional<AdaptiveSampling> adaptive);
+    // Throws std::invalid_argument for an unknown sampler name. `estimate_error` false skips the
+    // error estimate's calibration (its second renders), for a render whose estimate nobody reads.
+    RenderContext(const Scene& scene, std::optional<AdaptiveSampling> adaptive,
+                  bool estimate_error = true);
     // The integrator refers to the sampler, plan and BVH held here: the context stays put.
     RenderContext(const RenderContext&) = delete;
     RenderContext& operator=(const RenderContext&) = delete;
@@ -92,6 +94,7 @@ class RenderContext {
     Bvh bvh_;
     Integrator integrator_;
     std::optional<AdaptiveSampling> adaptive_;
+    bool estimate_error_;
     std::vector<Tile> tiles_;
 };
 

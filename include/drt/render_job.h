@@ -32,6 +32,10 @@ struct RenderJobOptions {
     std::optional<std::size_t> stop_after_tiles;
     // Hand the costliest tiles out first (costly_first, render_context.h); otherwise row by row.
     bool costly_first = true;
+    // False when nothing shows the image's error estimate: its calibration is skipped (up to 8 %
+    // of the camera samples, render_context.h). A checkpoint keeps the estimate's sums, so a
+    // render with one always estimates.
+    bool estimate_error = true;
     std::stop_token stop;
     const MpiJob* mpi = nullptr;  // absent: one process
 };
