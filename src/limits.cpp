@@ -13,6 +13,11 @@ std::uint64_t estimated_render_bytes(const RenderSettings& settings, int threads
            std::uint64_t(std::max(threads, 1)) * samples * kBytesPerSample;
 }
 
+int worker_threads(int threads) {
+    return threads > 0 ? threads
+                       : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+
 std::optional<std::string> render_limit_problem(const RenderSettings& s, int threads) {
     const auto over = [](const std::string& what, std::uint64_t value, std::uint64_t limit) {
         return what + " " + std::to_string(value) + " exceeds the limit of " +
@@ -34,8 +39,7 @@ std::optional<std::string> render_limit_problem(const RenderSettings& s, int thr
     if (s.glossy_rays > kMaxRaysPerPoint)
         return over("glossy rays", s.glossy_rays, kMaxRaysPerPoint);
     if (s.max_depth > kMaxDepthLimit) return over("max depth", s.max_depth, kMaxDepthLimit);
-    const int workers =
-        threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    const int workers = worker_threads(threads);
     const std::uint64_t bytes = estimated_render_bytes(s, workers);
     if (bytes > kMemoryBudget) {
         return "the render needs an estimated " + std::to_string(bytes >> 20) + " MiB (" +

@@ -1,5 +1,6 @@
 #include "drt/mesh.h"
 
+#include "drt/limits.h"
 #include "drt/triangle_batch.h"
 
 #include <immintrin.h>
@@ -10,7 +11,6 @@
 #include <numeric>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <unordered_map>
 
 #include "drt/huge_pages.h"
@@ -330,7 +330,7 @@ std::size_t TriangleMesh::bytes() const {
 
 void TriangleMesh::build_hierarchy(int threads) {
     if (triangles_.empty()) return;
-    if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    threads = worker_threads(threads);
     BinaryTree tree = build_binary_tree(positions_, triangles_, threads);
     lo_ = tree.nodes[0].lo;
     hi_ = tree.nodes[0].hi;

@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "drt/checkpoint.h"
+#include "drt/limits.h"
 
 namespace drt {
 
@@ -401,8 +402,7 @@ MpiShare MpiJob::render(const RenderContext& context, std::vector<Tile> todo, Ti
     RenderOptions run = options;
     if (run.threads <= 0) {
         // The machine's cores are shared by the processes this job put on it.
-        run.threads = std::max(
-            1, static_cast<int>(std::thread::hardware_concurrency()) / std::max(1, local_size()));
+        run.threads = std::max(1, worker_threads(0) / std::max(1, local_size()));
     }
     if (leader()) {
         LeaderQueue queue(std::move(todo), options.stop);

@@ -3,10 +3,10 @@
 #include <atomic>
 #include <chrono>
 #include <string>
-#include <thread>
 
 #include "drt/atomic_file.h"
 #include "drt/checkpoint.h"
+#include "drt/limits.h"
 #include "drt/render_context.h"
 #include "drt/tile.h"
 
@@ -94,10 +94,8 @@ RenderJobResult run_render_job(const Scene& scene, const RenderJobOptions& optio
         }
     }
     if (leader && options.costly_first) {
-        const int per_process =
-            run.threads > 0 ? run.threads : static_cast<int>(std::thread::hardware_concurrency());
         todo = costly_first(context, std::move(todo),
-                            per_process * (options.mpi ? options.mpi->size() : 1));
+                            worker_threads(run.threads) * (options.mpi ? options.mpi->size() : 1));
     }
     MpiShare share;
     if (options.mpi) {

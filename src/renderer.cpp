@@ -9,6 +9,8 @@
 #include <thread>
 #include <vector>
 
+#include "drt/limits.h"
+
 namespace drt {
 
 namespace {
@@ -24,10 +26,7 @@ double seconds_since(Clock::time_point start) {
 int render_tiles(const RenderContext& context, TileSource& source, TileSink& sink,
                  const RenderOptions& options) {
     const int threads =
-        std::max(1, std::min<int>(options.threads > 0
-                                      ? options.threads
-                                      : static_cast<int>(std::thread::hardware_concurrency()),
-                                  static_cast<int>(source.size())));
+        std::max(1, std::min(worker_threads(options.threads), static_cast<int>(source.size())));
     std::atomic<std::size_t> tiles_done{0};
     std::atomic<bool> failed{false};
     std::exception_ptr error;  // the first one thrown; guarded by mutex

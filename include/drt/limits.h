@@ -42,6 +42,9 @@ inline constexpr int kMaxDepthLimit = 512;
 // Worker threads: more than the cores of any machine drt runs on, and each takes per-sample
 // memory (kBytesPerSample) of its own.
 inline constexpr int kMaxThreads = 1024;
+// The worker threads a `threads` option means: itself, or for 0 all the machine's cores (at
+// least one).
+int worker_threads(int threads);
 
 // A scene file larger than this is refused before it is parsed (the XML tree takes several
 // times the text).
