@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <climits>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include "drt/error_estimate.h"
@@ -110,8 +113,11 @@ std::uint64_t RenderContext::estimate_cost(const Tile& tile) const {
             ++pilots;
         }
     }
+    // Shadow rays left out: a shading point's own work (its light sampling, textures, bump
+    // maps) dwarfs what its shadow rays add (docs/design.md, "costliest first").
+    const std::uint64_t shaded = rays.camera + rays.reflection + rays.refraction;
     const auto pixels = static_cast<std::uint64_t>(tile.width()) * tile.height();
-    return pilots == 0 ? 0 : rays.total() * pixels / pilots;
+    return pilots == 0 ? 0 : shaded * pixels / pilots;
 }
 
 // The key of the second, independent pattern of a pixel rendered twice: a ray-tree path of its
@@ -198,11 +204,24 @@ RenderContext::Pixel RenderContext::adaptive_pixel(int x, int y, std::uint64_t p
     return {sum / n, pixel_spread(scratch.taken), n, converged};
 }
 
-std::vector<Tile> costly_first(const RenderContext& context, std::vector<Tile> tiles, int workers) {
+std::vector<Tile> costly_first(const RenderContext& context, std::vector<Tile> tiles, int workers,
+                               int threads) {
     if (workers <= 1 || tiles.size() <= 1) return tiles;
-    std::vector<std::pair<std::uint64_t, Tile> > costed;
-    costed.reserve(tiles.size());
-    for (const Tile& t : tiles) costed.emplace_back(context.estimate_cost(t), t);
+    std::vector<std::pair<std::uint64_t, Tile> > costed(tiles.size());
+    // The pilot runs before any worker starts: spread over the threads, it keeps them waiting
+    // for a share of it only.
+    std::atomic<std::size_t> next{0};
+    const auto pilot = [&] {
+        for (std::size_t i = next++; i < tiles.size(); i = next++) {
+            costed[i] = {context.estimate_cost(tiles[i]), tiles[i]};
+        }
+    };
+    {
+        std::vector<std::jthread> helpers;
+        const auto most = static_cast<int>(std::min<std::size_t>(tiles.size(), INT_MAX));
+        for (int h = 1; h < std::min(threads, most); ++h) helpers.emplace_back(pilot);
+        pilot();
+    }
     std::stable_sort(costed.begin(), costed.end(),
                      [](const auto& a, const auto& b) { return a.first > b.first; });
     for (std::size_t i = 0; i < tiles.size(); ++i) tiles[i] = costed[i].second;

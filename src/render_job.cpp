@@ -94,8 +94,9 @@ RenderJobResult run_render_job(const Scene& scene, const RenderJobOptions& optio
         }
     }
     if (leader && options.costly_first) {
+        const int threads = worker_threads(run.threads);
         todo = costly_first(context, std::move(todo),
-                            worker_threads(run.threads) * (options.mpi ? options.mpi->size() : 1));
+                            threads * (options.mpi ? options.mpi->size() : 1), threads);
     }
     MpiShare share;
     if (options.mpi) {

@@ -1,6 +1,6 @@
-// The cost guess that orders the tiles: rays a pilot traces, scaled to the tile, and the order
-// it gives (which changes no pixel: renderer_test.cpp renders tiles in any order); a render
-// without its error estimate.
+// The cost guess that orders the tiles: shaded rays a pilot traces, scaled to the tile, and the
+// order it gives (which changes no pixel: renderer_test.cpp renders tiles in any order); a
+// render without its error estimate.
 #include "drt/render_context.h"
 
 #include <gtest/gtest.h>
@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "drt/light.h"
 #include "test_scenes.h"
 
 namespace drt {
@@ -20,7 +21,7 @@ Scene mirror_ball() {
     return testing::lone_sphere_scene(testing::mirror({0.5, 0.5, 0.5}), {0.1, 0.2, 0.3}, 96);
 }
 
-TEST(EstimateCost, CountsThePilotsRaysScaledToTheTile) {
+TEST(EstimateCost, CountsThePilotsShadedRaysScaledToTheTile) {
     const Scene scene = mirror_ball();
     const RenderContext context(scene, std::nullopt);
     const std::vector<Tile>& tiles = context.tiles();
@@ -35,6 +36,21 @@ TEST(EstimateCost, CountsThePilotsRaysScaledToTheTile) {
     const RenderContext cut(narrow, std::nullopt);
     EXPECT_EQ(cut.tiles()[5].width(), 8);
     EXPECT_EQ(cut.estimate_cost(cut.tiles()[5]), 128u);
+}
+
+TEST(EstimateCost, LeavesShadowRaysOut) {
+    // A grey ball lit through 8 shadow rays a shading point: the tiles on the ball trace 9 rays a
+    // camera sample, those of the background 1, yet both count one shaded ray a pixel — a shading
+    // point's own work, not its shadow rays, is what a tile's time follows (design.md).
+    Scene scene = testing::lone_sphere_scene(testing::grey_lambert(), {0.1, 0.2, 0.3}, 96);
+    scene.settings.shadow_rays = 8;
+    scene.lights.push_back(
+        std::make_unique<SphereLight>(Vec3{0, 5, -10}, 1.0, Color{1, 1, 1}, false));
+    const RenderContext context(scene, std::nullopt);
+    const TileBuffer ball = context.render_tile(context.tiles()[14]);
+    ASSERT_EQ(ball.rays.shadow, 8u * ball.rays.camera);  // every pixel on the lit side
+    EXPECT_EQ(context.estimate_cost(context.tiles()[14]), 256u);
+    EXPECT_EQ(context.estimate_cost(context.tiles()[0]), 256u);
 }
 
 TEST(CostlyFirst, OrdersByFallingCostAndKeepsIndexOrderAmongEquals) {
@@ -53,6 +69,15 @@ TEST(CostlyFirst, OrdersByFallingCostAndKeepsIndexOrderAmongEquals) {
             EXPECT_LT(order[i - 1].index, order[i].index) << i;
         }
     }
+}
+
+TEST(CostlyFirst, ThePilotsThreadsChangeNoPlace) {
+    const Scene scene = testing::scaled_scene("thesis/test4.xml", 80, 4);
+    const RenderContext context(scene, std::nullopt);
+    const std::vector<Tile> one = costly_first(context, context.tiles(), 2, 1);
+    ASSERT_NE(one, context.tiles());
+    EXPECT_EQ(costly_first(context, context.tiles(), 2, 3), one);
+    EXPECT_EQ(costly_first(context, context.tiles(), 2, 64), one);  // more threads than tiles
 }
 
 TEST(CostlyFirst, LeavesOneWorkersTilesAlone) {

@@ -53,11 +53,12 @@ class RenderContext {
     // Renders every pixel of `tile`. Safe to call from several threads at once.
     TileBuffer render_tile(const Tile& tile) const;
 
-    // A guess at what render_tile(tile) costs, in rays: those one camera sample traces at a
-    // pilot pixel in each 4 × 4 block of the tile (8 × 8 under 16 samples per pixel), scaled to
-    // the tile's pixels. Ray counts, not clock time, so the guess is the same on every machine
-    // and in every run; the pilot costs 1/16 of one sample per pixel (under 0.4 % of the render
-    // at 16 samples or more, 1.6 % at 1) and changes no pixel.
+    // A guess at what render_tile(tile) costs, in shaded rays (camera, reflection and refraction
+    // rays: shadow rays left out, cheap beside the shading they serve): those one camera sample
+    // traces at a pilot pixel in each 4 × 4 block of the tile (8 × 8 under 16 samples per
+    // pixel), scaled to the tile's pixels. Ray counts, not clock time, so the guess is the same
+    // on every machine and in every run; the pilot costs 1/16 of one sample per pixel (under
+    // 0.4 % of the render at 16 samples or more, 1.6 % at 1) and changes no pixel.
     std::uint64_t estimate_cost(const Tile& tile) const;
 
   private:
@@ -101,7 +102,9 @@ class RenderContext {
 // `tiles` with the costliest by estimate_cost first (equal guesses in index order): handed out in
 // this order, the slow tiles start early and the render's tail, when some workers have nothing
 // left while others finish, is one cheap tile long rather than one costly one. A render of one
-// worker gains nothing from it and gets `tiles` back untouched.
-std::vector<Tile> costly_first(const RenderContext& context, std::vector<Tile> tiles, int workers);
+// worker gains nothing from it and gets `tiles` back untouched. `threads` (this process's)
+// share the pilot.
+std::vector<Tile> costly_first(const RenderContext& context, std::vector<Tile> tiles, int workers,
+                               int threads = 1);
 
 }  // namespace drt
