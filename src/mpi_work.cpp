@@ -1,5 +1,7 @@
 #include "drt/mpi_work.h"
 
+#include <sched.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -28,7 +30,23 @@ bool launched_by_mpirun(const std::function<const char*(const char*)>& getenv) {
     return false;
 }
 
+bool bound_by_mpirun_default(const std::function<const char*(const char*)>& getenv) {
+    const char* bound = getenv("OMPI_MCA_orte_bound_at_launch");
+    const char* asked = getenv("OMPI_MCA_hwloc_base_binding_policy");
+    return bound != nullptr && std::strcmp(bound, "1") == 0 && (asked == nullptr || *asked == '\0');
+}
+
 namespace {
+
+// Lets the calling thread, and the threads it starts from now on, run on every CPU: the kernel
+// keeps them within the CPUs the system allows the process (a batch system's cpuset).
+void run_on_every_cpu() {
+    cpu_set_t every;
+    CPU_ZERO(&every);
+    for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu) CPU_SET(cpu, &every);
+    // On failure the binding stays: slower, never wrong.
+    (void)sched_setaffinity(0, sizeof every, &every);
+}
 
 using Clock = std::chrono::steady_clock;
 
@@ -375,6 +393,8 @@ void work_for_leader(const Transport& transport, const RenderContext& context, W
 }  // namespace
 
 MpiJob::MpiJob() {
+    // Before MPI starts its threads, so that they inherit it.
+    if (bound_by_mpirun_default()) run_on_every_cpu();
     const std::filesystem::path file = mpi_module_path();
     try {
         module_ = std::make_unique<SharedModule>(file);

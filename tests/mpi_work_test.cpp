@@ -40,6 +40,23 @@ TEST(LaunchedByMpirun, OnlyALaunchersVariablesCount) {
     EXPECT_TRUE(with({{"PMI_RANK", "1"}}));              // MPICH's hydra
 }
 
+TEST(BoundByMpirunDefault, OnlyMpirunsOwnBindingIsUndone) {
+    const auto with = [](std::map<std::string, std::string> env) {
+        return bound_by_mpirun_default([&](const char* name) -> const char* {
+            const auto it = env.find(name);
+            return it == env.end() ? nullptr : it->second.c_str();
+        });
+    };
+    EXPECT_FALSE(with({}));  // not bound by mpirun (a plain run, srun, --bind-to none)
+    EXPECT_TRUE(with({{"OMPI_MCA_orte_bound_at_launch", "1"}}));  // mpirun's default
+    EXPECT_TRUE(
+        with({{"OMPI_MCA_orte_bound_at_launch", "1"}, {"OMPI_MCA_hwloc_base_binding_policy", ""}}));
+    // The user asked: mpirun --bind-to core (or the MCA variable) is kept.
+    EXPECT_FALSE(with(
+        {{"OMPI_MCA_orte_bound_at_launch", "1"}, {"OMPI_MCA_hwloc_base_binding_policy", "core"}}));
+    EXPECT_FALSE(with({{"OMPI_MCA_orte_bound_at_launch", "0"}}));
+}
+
 const fs::path kSource = DRT_SOURCE_DIR;
 // Motion blur, depth of field, glossy reflection, soft shadows.
 const std::string kMotion = (kSource / "scenes/thesis/test5.xml").string();

@@ -26,6 +26,14 @@ namespace drt {
 // costs and prints exactly what it did before MPI existed.
 bool launched_by_mpirun(const std::function<const char*(const char*)>& getenv = std::getenv);
 
+// True when Open MPI's mpirun bound this process to CPUs by its own default (to one core each
+// for up to two processes, to a socket beyond), not because the user asked for it (--bind-to,
+// which mpirun passes on as OMPI_MCA_hwloc_base_binding_policy). That default suits processes of
+// one thread; drt's run several (workers, a communication thread, MPI's own), and bound to one
+// core they share it: `mpirun -n 1 drt` ran its two workers on one of two cores. MpiJob then
+// lets the process's threads run on every CPU the system allows it, as a plain run's do.
+bool bound_by_mpirun_default(const std::function<const char*(const char*)>& getenv = std::getenv);
+
 // What MpiJob::render did on this process.
 struct MpiShare {
     int threads = 0;  // worker threads of this process
@@ -40,7 +48,8 @@ struct MpiShare {
 // MPI, started for the life of this object; constructed only when launched_by_mpirun().
 class MpiJob {
   public:
-    // Loads drt_mpi.so from beside the running binary and starts MPI. Throws
+    // Undoes mpirun's default binding (bound_by_mpirun_default), loads drt_mpi.so from beside
+    // the running binary and starts MPI. Throws
     // std::runtime_error, saying what to do, when the module is missing or MPI cannot start.
     MpiJob();
     ~MpiJob();
