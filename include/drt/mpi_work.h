@@ -31,7 +31,9 @@ bool launched_by_mpirun(const std::function<const char*(const char*)>& getenv = 
 // which mpirun passes on as OMPI_MCA_hwloc_base_binding_policy). That default suits processes of
 // one thread; drt's run several (workers, a communication thread, MPI's own), and bound to one
 // core they share it: `mpirun -n 1 drt` ran its two workers on one of two cores. MpiJob then
-// lets the process's threads run on every CPU the system allows it, as a plain run's do.
+// lets the process's threads run on every CPU the system allows it, as a plain run's do, when
+// the binding gave it fewer CPUs than its share of the machine (its cores over the job's
+// processes there).
 bool bound_by_mpirun_default(const std::function<const char*(const char*)>& getenv = std::getenv);
 
 // What MpiJob::render did on this process.
@@ -48,8 +50,8 @@ struct MpiShare {
 // MPI, started for the life of this object; constructed only when launched_by_mpirun().
 class MpiJob {
   public:
-    // Undoes mpirun's default binding (bound_by_mpirun_default), loads drt_mpi.so from beside
-    // the running binary and starts MPI. Throws
+    // Loads drt_mpi.so from beside the running binary, starts MPI and undoes mpirun's default
+    // binding where it leaves the process less than its share (bound_by_mpirun_default). Throws
     // std::runtime_error, saying what to do, when the module is missing or MPI cannot start.
     MpiJob();
     ~MpiJob();
