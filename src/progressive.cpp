@@ -29,7 +29,9 @@ constexpr double kIndependentSlope = -0.5;
 constexpr double kTimeShare = 0.9;
 // Predicted counts are raised by this much: a round that misses the target costs a whole
 // round more.
-constexpr double kSpare = 1.1;
+constexpr double kSpare = 1.05;
+// A round after a final round that missed: at least this many times its count.
+constexpr double kRetryGrowth = 1.1;
 
 // The image's estimated RMSE, where the render can estimate it.
 std::optional<double> estimated_error(const RenderResult& r) {
@@ -79,7 +81,7 @@ double predicted_seconds(const std::vector<ProgressiveRound>& rounds, int spp) {
 }
 
 std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, double target,
-                                  int max_samples) {
+                                  int max_samples, double steepest) {
     std::vector<const ProgressiveRound*> measured;
     for (const ProgressiveRound& r : rounds) {
         if (r.error && *r.error > 0 && std::isfinite(*r.error)) measured.push_back(&r);
@@ -93,7 +95,7 @@ std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, d
                                 [&](const auto* r) { return r->spp * kMinSlopeSpan <= b.spp; });
     if (a != measured.rend()) {
         slope = std::clamp(std::log(*b.error / *(*a)->error) / std::log(double(b.spp) / (*a)->spp),
-                           -1.0, -0.25);
+                           steepest, -0.25);
     }
     double spp = b.spp;
     if (*b.error > target) spp = b.spp * std::pow(target / *b.error, 1 / slope) * kSpare;
@@ -104,14 +106,21 @@ std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, d
 NextRound next_round(const std::vector<ProgressiveRound>& rounds, double target, int max_samples) {
     const ProgressiveRound& last = rounds.back();
     if ((last.error && *last.error <= target) || last.spp >= max_samples) return {};
-    const auto p = predict(rounds, target, max_samples);
+    // After a round meant as the last that missed, no slope steeper than -1/2: the errors' curves
+    // flatten with samples (a pattern's gain over independent samples shrinks), so the slope
+    // that led there was too steep, and a second miss costs a whole round more.
+    const std::vector<ProgressiveRound> before(rounds.begin(), rounds.end() - 1);
+    const bool missed = !before.empty() && next_round(before, target, max_samples).final;
+    const auto p = predict(rounds, target, max_samples, missed ? kIndependentSlope : -1.0);
     NextRound next{p ? p->spp : kMinPilotGrowth * last.spp, p.has_value()};
     if (next.spp > kFinalStep * last.spp) {
         next = {std::max((next.spp + kFinalStep - 1) / kFinalStep, kMinPilotGrowth * last.spp),
                 false};
     }
-    // At least a quarter more, or the round is not worth its time.
-    next.spp = std::max<double>(next.spp, std::ceil(1.25 * last.spp));
+    // At least a quarter more, or the round is not worth its time; after a near miss a tenth
+    // more, since the estimate's noise alone (some 10 % a round on small images) decides many a
+    // miss, and a quarter more would often overshoot.
+    next.spp = std::max<double>(next.spp, std::ceil((missed ? kRetryGrowth : 1.25) * last.spp));
     next.spp = static_cast<int>(std::min<double>(next.spp, max_samples));
     return next;
 }

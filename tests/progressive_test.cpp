@@ -27,15 +27,15 @@ using test::read_bytes;
 using test::regex_groups;
 using test::run_drt;
 
-TEST(Predict, ExtrapolatesTheLastTwoErrorsAlongTheirSlopeWithATenthToSpare) {
+TEST(Predict, ExtrapolatesTheLastTwoErrorsAlongTheirSlopeWithATwentiethToSpare) {
     // Error halving from 8 to 32 samples: slope -1/2, so a quarter of the error needs 16 times
-    // the samples: 32 * 16 * 1.1 = 563.2.
+    // the samples: 32 * 16 * 1.05 = 537.6.
     const std::vector<ProgressiveRound> rounds{{8, 1.0, 0.08}, {32, 2.5, 0.04}};
     const auto p = predict(rounds, 0.01, 65536);
     ASSERT_TRUE(p);
-    EXPECT_EQ(p->spp, 564);
+    EXPECT_EQ(p->spp, 538);
     // Time: 0.5 s of set-up and 1.5 s / 24 samples = 0.0625 s a sample.
-    EXPECT_DOUBLE_EQ(p->seconds, 0.5 + 0.0625 * 564);
+    EXPECT_DOUBLE_EQ(p->seconds, 0.5 + 0.0625 * 538);
     // Met already: the last count.
     EXPECT_EQ(predict(rounds, 0.05, 65536)->spp, 32);
     // Capped at the maximum.
@@ -45,30 +45,33 @@ TEST(Predict, ExtrapolatesTheLastTwoErrorsAlongTheirSlopeWithATenthToSpare) {
 TEST(Predict, HoldsTheSlopeBetweenMinusOneAndMinusAQuarter) {
     // A flat pair of pilots (slope 0) is taken as -1/4: half the error needs 16 times the samples.
     const std::vector<ProgressiveRound> flat{{8, 1, 0.08}, {32, 2, 0.08}};
-    EXPECT_EQ(predict(flat, 0.04, 65536)->spp, static_cast<int>(std::ceil(32 * 16 * 1.1)));
+    EXPECT_EQ(predict(flat, 0.04, 65536)->spp, static_cast<int>(std::ceil(32 * 16 * 1.05)));
     // A slope of -2 (luck) is taken as -1: half the error needs twice the samples.
     const std::vector<ProgressiveRound> steep{{8, 1, 0.16}, {32, 2, 0.01}};
-    EXPECT_EQ(predict(steep, 0.005, 65536)->spp, static_cast<int>(std::ceil(32 * 2 * 1.1)));
+    EXPECT_EQ(predict(steep, 0.005, 65536)->spp, static_cast<int>(std::ceil(32 * 2 * 1.05)));
+    // Held at -1/2 instead: a quarter of the error needs 16 times the samples.
+    EXPECT_EQ(predict(steep, 0.0025, 65536, -0.5)->spp,
+              static_cast<int>(std::ceil(32 * 16 * 1.05)));
 }
 
 TEST(Predict, FromOneRoundTakesTheSlopeOfIndependentSamples) {
-    // Slope -1/2: an eighth of the error needs 64 times the samples: 8 * 64 * 1.1 = 563.2.
+    // Slope -1/2: an eighth of the error needs 64 times the samples: 8 * 64 * 1.05 = 537.6.
     const auto p = predict({{8, 1.0, 0.08}}, 0.01, 65536);
     ASSERT_TRUE(p);
-    EXPECT_EQ(p->spp, 564);
-    EXPECT_DOUBLE_EQ(p->seconds, 564 / 8.0);
+    EXPECT_EQ(p->spp, 538);
+    EXPECT_DOUBLE_EQ(p->seconds, 538 / 8.0);
     // Rounds without an estimate are skipped: the slope is still the assumed one.
-    EXPECT_EQ(predict({{4, 1, std::nullopt}, {8, 1, 0.08}}, 0.01, 65536)->spp, 564);
+    EXPECT_EQ(predict({{4, 1, std::nullopt}, {8, 1, 0.08}}, 0.01, 65536)->spp, 538);
 }
 
 TEST(Predict, TakesTheSlopeOverAtLeastThreefoldTheSamples) {
     // 100 to 120 samples: too narrow a span for a slope, so -1/2 from the last round:
-    // 120 * 1.21 * 1.1 = 159.72.
-    EXPECT_EQ(predict({{100, 1, 0.2}, {120, 1, 0.011}}, 0.01, 65536)->spp, 160);
+    // 120 * 1.21 * 1.05 = 152.46.
+    EXPECT_EQ(predict({{100, 1, 0.2}, {120, 1, 0.011}}, 0.01, 65536)->spp, 153);
     // With a round a third as large before them, the slope from it: 40 to 120 samples, error
-    // 0.022 to 0.011, slope -0.63; 120 * 1.1^(1 / 0.63) * 1.1 = 153.5.
+    // 0.022 to 0.011, slope -0.63; 120 * 1.1^(1 / 0.63) * 1.05 = 146.5.
     const std::vector<ProgressiveRound> rounds{{40, 1, 0.022}, {100, 1, 0.2}, {120, 1, 0.011}};
-    EXPECT_EQ(predict(rounds, 0.01, 65536)->spp, 154);
+    EXPECT_EQ(predict(rounds, 0.01, 65536)->spp, 147);
 }
 
 TEST(Predict, NeedsARoundWithAPositiveEstimate) {
@@ -77,10 +80,10 @@ TEST(Predict, NeedsARoundWithAPositiveEstimate) {
 }
 
 TEST(NextRound, ThePredictedCountWhenWithinTheFinalStep) {
-    // 32 * 4 * 1.1 = 140.8: at most 12 times 32, so the round the target is predicted to need.
+    // 32 * 4 * 1.05 = 134.4: at most 12 times 32, so the round the target is predicted to need.
     const std::vector<ProgressiveRound> rounds{{8, 1.0, 0.08}, {32, 2.5, 0.04}};
     const NextRound n = next_round(rounds, 0.02, 65536);
-    EXPECT_EQ(n.spp, 141);
+    EXPECT_EQ(n.spp, 135);
     EXPECT_TRUE(n.final);
     // Capped at the maximum, and nothing once it is reached or the target is met.
     EXPECT_EQ(next_round(rounds, 0.02, 100).spp, 100);
@@ -89,24 +92,44 @@ TEST(NextRound, ThePredictedCountWhenWithinTheFinalStep) {
 }
 
 TEST(NextRound, APilotATwelfthOfAPredictionFurtherAway) {
-    // 32 * 256 * 1.1 = 9011.2 -> 9012, more than 12 times 32: a pilot of 9012 / 12 = 751.
+    // 32 * 256 * 1.05 = 8601.6 -> 8602, more than 12 times 32: a pilot of 8602 / 12 = 717.
     const std::vector<ProgressiveRound> rounds{{8, 1.0, 0.08}, {32, 2.5, 0.04}};
     const NextRound n = next_round(rounds, 0.0025, 65536);
-    EXPECT_EQ(n.spp, 751);
+    EXPECT_EQ(n.spp, 717);
     EXPECT_FALSE(n.final);
-    // From the first pilot alone (slope -1/2): 8 * 400 * 1.1 = 3520 -> a pilot of 294.
-    EXPECT_EQ(next_round({{8, 1.0, 0.2}}, 0.01, 65536).spp, 294);
-    // A twelfth that is less than 4 times the last round is raised to 4 times: 32 * 16 * 1.1 =
-    // 563.2 -> 564, a twelfth 47, raised to 128.
+    // From the first pilot alone (slope -1/2): 8 * 441 * 1.05 = 3704.4 -> a pilot of 309.
+    EXPECT_EQ(next_round({{8, 1.0, 0.21}}, 0.01, 65536).spp, 309);
+    // A twelfth that is less than 4 times the last round is raised to 4 times: 32 * 16 * 1.05 =
+    // 537.6 -> 538, a twelfth 45, raised to 128.
     EXPECT_EQ(next_round(rounds, 0.01, 65536).spp, 128);
 }
 
 TEST(NextRound, AtLeastAQuarterMoreAndFourTimesWithoutAnEstimate) {
-    // Just over the target: 100 * 1.1 would be 110, raised to 125.
-    EXPECT_EQ(next_round({{50, 1, 0.02}, {100, 2, 0.0100001}}, 0.01, 65536).spp, 125);
+    // Just over the target: 100 * 1.05 would be 106, raised to 125.
+    EXPECT_EQ(next_round({{100, 2, 0.0100001}}, 0.01, 65536).spp, 125);
     const NextRound blind = next_round({{8, 1, std::nullopt}}, 0.01, 65536);
     EXPECT_EQ(blind.spp, 32);
     EXPECT_FALSE(blind.final);
+}
+
+TEST(NextRound, AfterAFinalRoundThatMissedASlopeNoSteeperThanMinusAHalf) {
+    // The pilots 8 and 32 measure -0.87, which predicts 120 spp as the final round. It misses:
+    // from 32 to 120 the slope was -0.80, but the next round goes along -1/2, 120 * 1.04^2 *
+    // 1.05 = 136.3 (-0.80 and a quarter more, as before a miss, would have been 150).
+    const std::vector<ProgressiveRound> pilots{{8, 1, 0.1}, {32, 1, 0.03}};
+    const NextRound final = next_round(pilots, 0.01, 65536);
+    EXPECT_EQ(final.spp, 120);
+    EXPECT_TRUE(final.final);
+    std::vector<ProgressiveRound> missed = pilots;
+    missed.push_back({120, 1, 0.0104});
+    EXPECT_EQ(next_round(missed, 0.01, 65536).spp, 137);
+    // A near miss: at least a tenth more (51 * 1.1 = 56.1), not a quarter (64).
+    const NextRound near = next_round({{40, 1, 0.011}}, 0.01, 65536);
+    EXPECT_EQ(near.spp, 51);
+    EXPECT_TRUE(near.final);
+    EXPECT_EQ(next_round({{40, 1, 0.011}, {51, 1, 0.0101}}, 0.01, 65536).spp, 57);
+    // A pilot that is not the last round is no miss: the quarter still holds.
+    EXPECT_EQ(next_round({{8, 1, 0.2}, {32, 1, 0.0101}}, 0.01, 65536).spp, 40);
 }
 
 TEST(PredictedSeconds, ALineThroughTheLastTwoRoundsOrProportionalToOne) {

@@ -39,14 +39,14 @@ struct Prediction {
 };
 
 // The count at which the error of the last round, extrapolated along the log-log slope from the
-// latest round with an estimate and at most a third of its count (held between -1 and -1/4:
-// rounds are noisy), falls to `target`, with 10 % to spare, at most `max_samples`; the time from
-// a line through the rounds' times. Without such a round the slope is taken as -1/2, that of
-// independent samples, which no sampler drt has falls short of (stratified and Sobol patterns
+// latest round with an estimate and at most a third of its count (held between `steepest` and
+// -1/4: rounds are noisy), falls to `target`, with 5 % to spare, at most `max_samples`; the time
+// from a line through the rounds' times. Without such a round the slope is taken as -1/2, that
+// of independent samples, which no sampler drt has falls short of (stratified and Sobol patterns
 // converge faster), so the count errs on the large side. Absent when no round has a positive
 // estimate.
 std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, double target,
-                                  int max_samples);
+                                  int max_samples, double steepest = -1.0);
 
 // Seconds a render of `spp` samples takes, from a line (set-up plus a cost per sample) through
 // the last two rounds' times; from the last round alone when there is one.
@@ -57,6 +57,8 @@ double predicted_seconds(const std::vector<ProgressiveRound>& rounds, int spp);
 // kFinalStep times the last round's (`final`), otherwise a pilot a kFinalStep-th of it (at least 4
 // times the last round), whose error against the last round's measures the slope over a wide span,
 // so that the next prediction extrapolates only kFinalStep-fold and lands on the count in one step.
+// After a final round that missed (the estimate's noise decides many), the prediction along a
+// slope no steeper than -1/2, and at least a tenth more samples (otherwise a quarter).
 struct NextRound {
     int spp = 0;
     bool final = false;
