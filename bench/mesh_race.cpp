@@ -10,8 +10,9 @@
 // for any hit (rtcOccluded1). The two sides alternate, round after round, on the same threads.
 //
 // Usage: drt_mesh_race SCENE.xml [--subdivide N] [--spp N] [--rounds N] [--threads N]
-//                      [--write-obj FILE]
+//                      [--write-obj FILE] [--dump FILE]
 // --write-obj writes the (subdivided) mesh in the scene's coordinates, for a render of it.
+// --dump writes drt's exact answers, which two versions of the traversal must share.
 #include <embree3/rtcore.h>
 
 #include <algorithm>
@@ -241,6 +242,7 @@ struct Options {
     std::filesystem::path scene;
     int subdivide = 0, spp = 1, rounds = 5, threads = 2;
     std::filesystem::path write_obj;
+    std::filesystem::path dump;
 };
 
 Options parse(int argc, char** argv) {
@@ -261,6 +263,8 @@ Options parse(int argc, char** argv) {
             o.threads = std::stoi(value());
         else if (a == "--write-obj")
             o.write_obj = value();
+        else if (a == "--dump")
+            o.dump = value();
         else
             o.scene = a;
     }
@@ -304,6 +308,24 @@ void race(const char* kind, const std::vector<MeshRay>& rays, int rounds, int th
         "ratio %.2f  agree %zu/%zu (%.4f %%)\n",
         kind, rays.size(), 100.0 * hits / rays.size(), d, e, d / e, same, rays.size(),
         100.0 * same / rays.size());
+}
+
+// drt's exact answers (t, triangle and barycentrics of every camera ray's hit, yes or no for
+// every shadow ray), for telling whether two versions of the traversal answer alike.
+void dump_answers(const TriangleMesh& mesh, const RaySets& rays,
+                  const std::filesystem::path& path) {
+    std::ofstream file(path, std::ios::binary);
+    const auto put = [&](const auto& value) {
+        file.write(reinterpret_cast<const char*>(&value), sizeof value);
+    };
+    for (const MeshRay& r : rays.camera) {
+        const auto hit = mesh.intersect(r.ray, {0, r.t_max});
+        put(hit ? hit->t : -1.0);
+        put(hit ? hit->triangle : 0u);
+        put(hit ? hit->b.b0 : 0.0), put(hit ? hit->b.b1 : 0.0), put(hit ? hit->b.b2 : 0.0);
+    }
+    for (const MeshRay& r : rays.shadow) put(mesh.occluded(r.ray, {0, r.t_max}));
+    if (!file) throw std::runtime_error("cannot write " + path.string());
 }
 
 int run(const Options& options) {
@@ -373,6 +395,7 @@ int run(const Options& options) {
         [&](const MeshRay& r) {
             return e.occluded(r) ? Answer{1, 0} : Answer{-1, 0};
         });
+    if (!options.dump.empty()) dump_answers(m, local, options.dump);
     embree.reset();
     rtcReleaseDevice(device);
     return 0;
