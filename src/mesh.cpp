@@ -70,64 +70,124 @@ double corner_angle(const Vec3& a, const Vec3& b, const Vec3& c) {
     return std::atan2(length(cross(u, v)), dot(u, v));
 }
 
-// A ray as the 4-wide box test takes it: in single precision, and still conservative, so that
-// a box never misses a ray its triangle meets (the triangle test, in double, decides). The
-// origin rounded to float moves the ray by up to `err` on each axis, which widens each slab by
-// err / |d| in t (`slack`, doubled for the rounding of the additions); the remaining roundings
-// are relative and covered by widening the far end, as for doubles (Pharr, Jakob & Humphreys,
-// section 6.8.2 of the 4th edition). An axis the ray does not move along (or so little that
-// 1 / d overflows a float) is tested by where the origin is instead, since ±∞ · 0 would be NaN.
+// A ray as the wide box test takes it: in single precision, and still conservative, so that a
+// box never misses a ray its triangle meets (the triangle test, in double, decides). Each slab
+// distance is (plane − o)·(1/d) in float, with the origin o moved to a float on the side that
+// can only make the ray enter sooner and leave later: for the near plane above o where 1/d ≥ 0
+// (below where it is negative), for the far plane the other way. What is left is relative
+// rounding (the subtraction, the product and 1/d rounded to float: (1 + u)³ on each distance),
+// covered by widening the far end as for doubles (Pharr, Jakob & Humphreys, section 6.8.2 of
+// the 4th edition), and the near planes need no min or max: which side is near is known per ray.
+// An axis the ray does not move along (or so little that 1 / d overflows a float) is tested by
+// where the origin is instead, since ±∞ · 0 would be NaN.
 struct WideRay {
-    __m128 origin[3], inv_dir[3], slack[3];
-    __m128 below[3], above[3];  // a flat axis's origin, widened down and up
-    int flat = 0;               // bit k: axis k is flat
+    float inv_dir[3];
+    float start[3], end[3];    // the origin rounded for the near and for the far planes
+    int near_side[3];          // 0: the near plane of axis k is the box's low side, 1: its high
+    float below[3], above[3];  // a flat axis's origin, widened down and up
+    int flat = 0;              // bit k: axis k is flat
 
-    WideRay(const Ray& ray, Interval range) {
+    // `inv`: 1 / ray.dir, per axis.
+    WideRay(const Ray& ray, Interval range, const double (&inv)[4]) {
+        // The origin rounded to float, then moved out by at least one float step either way
+        // (|f|·2^-23 is no less than the spacing of floats at f, and the smallest float covers
+        // zero and the subnormals), without a branch: up ≥ origin ≥ down. An origin beyond the
+        // floats makes one of them NaN (∞ − ∞), which the max and min of `hits` ignore.
+        const __m128 f = _mm_movelh_ps(_mm_cvtpd_ps(_mm_setr_pd(ray.origin.x, ray.origin.y)),
+                                       _mm_cvtpd_ps(_mm_set_sd(ray.origin.z)));
+        const __m128 step =
+            _mm_add_ps(_mm_mul_ps(_mm_and_ps(f, _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff))),
+                                  _mm_set1_ps(0x1p-23f)),
+                       _mm_set1_ps(std::numeric_limits<float>::denorm_min()));
+        alignas(16) float up[4], down[4], inv_f[4];
+        _mm_store_ps(up, _mm_add_ps(f, step));
+        _mm_store_ps(down, _mm_sub_ps(f, step));
+        _mm_store_ps(inv_f, _mm_movelh_ps(_mm_cvtpd_ps(_mm_load_pd(inv)),
+                                          _mm_cvtpd_ps(_mm_load_sd(inv + 2))));
+        for (int k = 0; k < 3; ++k) {
+            near_side[k] = inv[k] < 0;
+            inv_dir[k] = inv_f[k];
+            start[k] = near_side[k] ? down[k] : up[k];
+            end[k] = near_side[k] ? up[k] : down[k];
+            if (!(std::abs(inv[k]) <= std::numeric_limits<float>::max())) make_flat(ray, range, k);
+        }
+    }
+
+    void make_flat(const Ray& ray, Interval range, int k) {
         // No hit on a mesh of float coordinates is farther than this.
         const double reach = std::min(range.max, 1e39 + 2 * max_abs_component(ray.origin));
-        for (int k = 0; k < 3; ++k) {
-            const auto o = static_cast<float>(ray.origin[k]);
-            const double inv = 1 / ray.dir[k];
-            const double err = std::abs(ray.origin[k] - o);
-            origin[k] = _mm_set1_ps(o);
-            if (!(std::abs(inv) <= std::numeric_limits<float>::max())) {
-                flat |= 1 << k;
-                const double drift = 2 * err + std::abs(ray.dir[k]) * reach;
-                below[k] = _mm_set1_ps(rounded_down(ray.origin[k] - drift));
-                above[k] = _mm_set1_ps(rounded_up(ray.origin[k] + drift));
-                continue;
-            }
-            inv_dir[k] = _mm_set1_ps(static_cast<float>(inv));
-            slack[k] = _mm_set1_ps(rounded_up(2 * err * std::abs(inv) * (1 + 1e-6)));
-        }
+        const double o = ray.origin[k];
+        flat |= 1 << k;
+        const double drift = 2 * std::abs(o - static_cast<float>(o)) + std::abs(ray.dir[k]) * reach;
+        below[k] = rounded_down(o - drift);
+        above[k] = rounded_up(o + drift);
+        inv_dir[k] = start[k] = end[k] = 0;
     }
 
     // The children whose boxes the ray meets inside [near, far] (bit k for child k), and where
     // it enters each. kFlat: whether any axis may be flat (a rare ray, tested apart so that the
-    // common one runs without branches).
+    // common one runs without branches). The 8-wide test with AVX, else two 4-wide ones: the
+    // same operations lane by lane, so every build visits the same boxes in the same order.
     template <bool kFlat>
-    int hits(const float (&lo)[3][4], const float (&hi)[3][4], float near, float far,
-             __m128& entry) const {
-        __m128 enter = _mm_set1_ps(near), leave = _mm_set1_ps(far);
-        __m128 inside = _mm_cmple_ps(enter, leave);
+    int hits(const float (&box)[2][3][8], float near, float far, float (&entry)[8]) const {
+#ifdef __AVX__
+        __m256 enter = _mm256_set1_ps(near), leave = _mm256_set1_ps(far);
+        __m256 inside = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
         for (int k = 0; k < 3; ++k) {
-            const __m128 l = _mm_load_ps(lo[k]), h = _mm_load_ps(hi[k]);
             if (kFlat && (flat >> k & 1)) {
-                inside = _mm_and_ps(
-                    inside, _mm_and_ps(_mm_cmple_ps(l, above[k]), _mm_cmpge_ps(h, below[k])));
+                const __m256 l = _mm256_load_ps(box[0][k]), h = _mm256_load_ps(box[1][k]);
+                inside = _mm256_and_ps(
+                    inside, _mm256_and_ps(_mm256_cmp_ps(l, _mm256_set1_ps(above[k]), _CMP_LE_OQ),
+                                          _mm256_cmp_ps(h, _mm256_set1_ps(below[k]), _CMP_GE_OQ)));
                 continue;
             }
-            const __m128 t0 = _mm_mul_ps(_mm_sub_ps(l, origin[k]), inv_dir[k]);
-            const __m128 t1 = _mm_mul_ps(_mm_sub_ps(h, origin[k]), inv_dir[k]);
-            enter = _mm_max_ps(_mm_sub_ps(_mm_min_ps(t0, t1), slack[k]), enter);
-            leave = _mm_min_ps(_mm_add_ps(_mm_max_ps(t0, t1), slack[k]), leave);
+            const __m256 inv = _mm256_set1_ps(inv_dir[k]);
+            const __m256 t0 = _mm256_mul_ps(
+                _mm256_sub_ps(_mm256_load_ps(box[near_side[k]][k]), _mm256_set1_ps(start[k])), inv);
+            const __m256 t1 = _mm256_mul_ps(
+                _mm256_sub_ps(_mm256_load_ps(box[1 - near_side[k]][k]), _mm256_set1_ps(end[k])),
+                inv);
+            enter = _mm256_max_ps(t0, enter);
+            leave = _mm256_min_ps(t1, leave);
         }
-        entry = enter;
-        return _mm_movemask_ps(
-            _mm_and_ps(inside, _mm_cmple_ps(enter, _mm_mul_ps(leave, _mm_set1_ps(kWiden)))));
+        _mm256_store_ps(entry, enter);
+        return _mm256_movemask_ps(_mm256_and_ps(
+            inside,
+            _mm256_cmp_ps(enter, _mm256_mul_ps(leave, _mm256_set1_ps(kWiden)), _CMP_LE_OQ)));
+#else
+        int mask = 0;
+        for (int half = 0; half < 8; half += 4) {
+            __m128 enter = _mm_set1_ps(near), leave = _mm_set1_ps(far);
+            __m128 inside = _mm_castsi128_ps(_mm_set1_epi32(-1));
+            for (int k = 0; k < 3; ++k) {
+                if (kFlat && (flat >> k & 1)) {
+                    const __m128 l = _mm_load_ps(box[0][k] + half),
+                                 h = _mm_load_ps(box[1][k] + half);
+                    inside = _mm_and_ps(inside, _mm_and_ps(_mm_cmple_ps(l, _mm_set1_ps(above[k])),
+                                                           _mm_cmpge_ps(h, _mm_set1_ps(below[k]))));
+                    continue;
+                }
+                const __m128 inv = _mm_set1_ps(inv_dir[k]);
+                const __m128 t0 = _mm_mul_ps(
+                    _mm_sub_ps(_mm_load_ps(box[near_side[k]][k] + half), _mm_set1_ps(start[k])),
+                    inv);
+                const __m128 t1 = _mm_mul_ps(
+                    _mm_sub_ps(_mm_load_ps(box[1 - near_side[k]][k] + half), _mm_set1_ps(end[k])),
+                    inv);
+                enter = _mm_max_ps(t0, enter);
+                leave = _mm_min_ps(t1, leave);
+            }
+            _mm_store_ps(entry + half, enter);
+            mask |= _mm_movemask_ps(_mm_and_ps(
+                        inside, _mm_cmple_ps(enter, _mm_mul_ps(leave, _mm_set1_ps(kWiden)))))
+                    << half;
+        }
+        return mask;
+#endif
     }
 
-    // 2γ(5) in single precision and some: the relative rounding of the slab distances.
+    // The relative rounding of the slab distances ((1 + u)³ on each end, u = 2^-24) and of
+    // this product, with room to spare.
     static constexpr float kWiden = 1 + 0x1p-19f;
 
     // x rounded to a float no smaller (no larger): the next float up from a conversion that
@@ -151,9 +211,9 @@ struct WideRay {
 // The traversal tests up to four triangles of a leaf at once (triangle_batch.h), for about what
 // one box test costs: a subtree of this many triangles or fewer is visited as one leaf.
 constexpr std::uint32_t kCollapsedLeaf = 4;
-// A node pushes at most three children besides the one it visits next, and no path is longer
+// A node pushes at most seven children besides the one it visits next, and no path is longer
 // than 64 nodes.
-constexpr int kStackSize = 256;
+constexpr int kStackSize = 7 * 64 + 1;
 
 }  // namespace
 
@@ -396,8 +456,8 @@ std::uint32_t TriangleMesh::widen(const std::vector<BinaryNode>& binary, std::ui
     const auto index = static_cast<std::uint32_t>(nodes_.size());
     nodes_.push_back({});
     // The node's binary children, then, while there is room, the inner one of largest surface
-    // area replaced by its two children: what a 4-wide node saves is the most boxes entered.
-    std::array<std::uint32_t, 4> kids{};
+    // area replaced by its two children: what a wide node saves is the most boxes entered.
+    std::array<std::uint32_t, kWidth> kids{};
     int n = 0;
     if (binary[node].count > 0) {
         kids[n++] = node;  // the whole tree is one leaf
@@ -408,7 +468,7 @@ std::uint32_t TriangleMesh::widen(const std::vector<BinaryNode>& binary, std::ui
     const auto area = [&](std::uint32_t k) {
         return Bounds{to_vec3(binary[k].lo), to_vec3(binary[k].hi)}.surface_area();
     };
-    while (n < 4) {
+    while (n < kWidth) {
         int open = -1;
         for (int k = 0; k < n; ++k) {
             if (binary[kids[k]].count == 0 && (open < 0 || area(kids[k]) > area(kids[open])))
@@ -422,8 +482,8 @@ std::uint32_t TriangleMesh::widen(const std::vector<BinaryNode>& binary, std::ui
     // Unused slots keep boxes at +∞ on both sides, which no ray enters, but `children` is what
     // the traversal reads.
     for (int a = 0; a < 3; ++a) {
-        for (int k = 0; k < 4; ++k) {
-            nodes_[index].lo[a][k] = nodes_[index].hi[a][k] =
+        for (int k = 0; k < kWidth; ++k) {
+            nodes_[index].box[0][a][k] = nodes_[index].box[1][a][k] =
                 std::numeric_limits<float>::infinity();
         }
     }
@@ -431,8 +491,8 @@ std::uint32_t TriangleMesh::widen(const std::vector<BinaryNode>& binary, std::ui
     for (int k = 0; k < n; ++k) {
         const BinaryNode& child = binary[kids[k]];
         for (int a = 0; a < 3; ++a) {
-            nodes_[index].lo[a][k] = child.lo[a];
-            nodes_[index].hi[a][k] = child.hi[a];
+            nodes_[index].box[0][a][k] = child.lo[a];
+            nodes_[index].box[1][a][k] = child.hi[a];
         }
         // (widen appends to nodes_: no reference into it is held across the call.)
         const std::uint32_t target = child.count > 0 ? child.offset : widen(binary, kids[k]);
@@ -446,11 +506,19 @@ template <bool kAnyHit>
 std::optional<MeshHit> TriangleMesh::traverse(const Ray& ray, Interval range,
                                               std::uint64_t* tests) const {
     if (nodes_.empty()) return std::nullopt;
-    const ShearedRay sheared(ray);
-    const WideRay wide(ray, range);
-    const FloatShearedRay filter(sheared);
+    // The per-ray set-up is a good part of a ray's cost: the double-precision sheared ray of the
+    // watertight test (two more divisions) is made only once a triangle passes the float
+    // filter; the filter's shear is the same to within what its bounds allow for.
+    alignas(16) double inv[4];
+    _mm_store_pd(inv, _mm_div_pd(_mm_set1_pd(1), _mm_setr_pd(ray.dir.x, ray.dir.y)));
+    inv[2] = 1 / ray.dir.z;
+    const WideRay wide(ray, range, inv);
+    const ShearedRay::Axes axes = ShearedRay::axes_of(ray.dir);
+    const FloatShearedRay filter(ray.origin, axes, ray.dir[axes.kx] * inv[axes.kz],
+                                 ray.dir[axes.ky] * inv[axes.kz], inv[axes.kz]);
+    std::optional<ShearedRay> sheared;
     const bool use_filter = filter.usable() && filter_fits_;
-    const std::array<int, 3> axes{filter.axis(0), filter.axis(1), filter.axis(2)};
+    const std::array<int, 3> order_of_axes{axes.kx, axes.ky, axes.kz};
     // The filter's near end must not be negative (triangle_batch.h); a negative range start
     // (never used by the renderer) leaves the near end to the double test.
     const float filter_near =
@@ -465,7 +533,7 @@ std::optional<MeshHit> TriangleMesh::traverse(const Ray& ray, Interval range,
             const Float3 &p0 = positions_[(*t[0])[v]], &p1 = positions_[(*t[1])[v]],
                          &p2 = positions_[(*t[2])[v]], &p3 = positions_[(*t[3])[v]];
             for (int a = 0; a < 3; ++a) {
-                const int k = axes[a];
+                const int k = order_of_axes[a];
                 batch.corners[v][a] = _mm_setr_ps(p0[k], p1[k], p2[k], p3[k]);
             }
         }
@@ -500,7 +568,8 @@ std::optional<MeshHit> TriangleMesh::traverse(const Ray& ray, Interval range,
                 for (; maybe != 0; maybe &= maybe - 1) {
                     const std::uint32_t i = first + std::countr_zero(static_cast<unsigned>(maybe));
                     const auto [a, b, c] = corners(i);
-                    if (const auto hit = intersect_triangle(sheared, a, b, c, range)) {
+                    if (!sheared) sheared.emplace(ray);
+                    if (const auto hit = intersect_triangle(*sheared, a, b, c, range)) {
                         best = MeshHit{hit->t, i, hit->b};
                         if constexpr (kAnyHit) return best;
                         range.max = hit->t;
@@ -510,16 +579,25 @@ std::optional<MeshHit> TriangleMesh::traverse(const Ray& ray, Interval range,
             }
         } else {
             const Node& node = nodes_[current.child];
-            __m128 entries;
-            const int mask = (flat ? wide.hits<true>(node.lo, node.hi, near, far, entries)
-                                   : wide.hits<false>(node.lo, node.hi, near, far, entries)) &
+            alignas(32) float entry[kWidth];
+            const int mask = (flat ? wide.hits<true>(node.box, near, far, entry)
+                                   : wide.hits<false>(node.box, near, far, entry)) &
                              ((1 << node.children) - 1);
+            if (mask != 0 && kAnyHit) {
+                // Any hit will do, and whichever is found first gives the same answer: the
+                // children in their order, without sorting them.
+                const int c = std::countr_zero(static_cast<unsigned>(mask));
+                for (int m = mask & (mask - 1); m != 0; m &= m - 1) {
+                    const int k = std::countr_zero(static_cast<unsigned>(m));
+                    stack[top++] = {node.child[k], node.count[k], entry[k]};
+                }
+                current = {node.child[c], node.count[c], entry[c]};
+                continue;
+            }
             if (mask != 0) {
-                alignas(16) float entry[4];
-                _mm_store_ps(entry, entries);
                 // The children met, nearest first; among equal entries the last child first,
-                // the order in which earlier versions visited them (so images do not change).
-                std::array<int, 4> order{};
+                // the order in which earlier versions visited them.
+                std::array<int, kWidth> order{};
                 int n = 0;
                 for (int m = mask; m != 0; m &= m - 1) {
                     const int c = std::countr_zero(static_cast<unsigned>(m));
@@ -533,11 +611,13 @@ std::optional<MeshHit> TriangleMesh::traverse(const Ray& ray, Interval range,
                 }
                 const int c = order[0];
                 current = {node.child[c], node.count[c], entry[c]};
-                // The nearest child's second cache line is fetched while its first is tested
+                // The nearest child's other cache lines are fetched while its first is tested
                 // (on a mesh of a million triangles most nodes come from memory).
                 if (current.count == 0) {
-                    _mm_prefetch(reinterpret_cast<const char*>(&nodes_[current.child]) + 64,
-                                 _MM_HINT_T0);
+                    const auto* next = reinterpret_cast<const char*>(&nodes_[current.child]);
+                    _mm_prefetch(next + 64, _MM_HINT_T0);
+                    _mm_prefetch(next + 128, _MM_HINT_T0);
+                    _mm_prefetch(next + 192, _MM_HINT_T0);
                 }
                 continue;
             }

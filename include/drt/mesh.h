@@ -94,17 +94,19 @@ class TriangleMesh {
     std::span<const std::byte> hierarchy() const { return std::as_bytes(std::span(nodes_)); }
 
   private:
-    // The tree traversed has up to four children a node, their boxes side by side so that one
-    // 4-wide SIMD test tests them all (Wald, Benthin & Boulos 2008; Dammertz et al. 2008):
-    // 128 bytes a node, aligned to start a cache line, so that a node is two lines, not three.
-    // A child is a node (`count` 0, `child` its index) or a leaf (`count` triangles from
-    // `child`); the first `children` slots are used.
+    // The tree traversed has up to eight children a node, their boxes side by side so that one
+    // 8-wide SIMD test (AVX; two 4-wide ones elsewhere) tests them all, as Embree does for
+    // single rays (Wald, Benthin & Boulos 2008; Dammertz et al. 2008): half the levels of a
+    // 4-wide tree. 256 bytes a node, aligned to start a cache line: the boxes are its first
+    // three lines. A child is a node (`count` 0, `child` its index) or a leaf (`count` triangles
+    // from `child`); the first `children` slots are used.
+    static constexpr int kWidth = 8;
     struct alignas(64) Node {
-        float lo[3][4], hi[3][4];  // [axis][child]
-        std::uint32_t child[4];
-        std::uint16_t count[4];
+        float box[2][3][kWidth];  // [low side, high side][axis][child]
+        std::uint32_t child[kWidth];
+        std::uint16_t count[kWidth];
         std::uint32_t children;
-        std::uint32_t unused;  // 0: a node has no padding bytes of unknown value
+        std::uint32_t unused[3];  // 0: a node has no padding bytes of unknown value
     };
 
     // The vertices, triangles and normals of the mesh from the file's.
@@ -117,7 +119,7 @@ class TriangleMesh {
     void order_vertices_by_leaves();
     // Turns every inner node whose subtree holds few triangles into a leaf of them all.
     static void collapse_small_subtrees(std::vector<BinaryNode>& binary);
-    // Turns the binary subtree at `node` into 4-wide nodes appended to nodes_; returns the index
+    // Turns the binary subtree at `node` into wide nodes appended to nodes_; returns the index
     // of the one made for `node`.
     std::uint32_t widen(const std::vector<BinaryNode>& binary, std::uint32_t node);
     // `tests`, when given, counts the triangles tested.

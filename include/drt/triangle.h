@@ -34,6 +34,21 @@ struct TriangleHit {
 struct ShearedRay {
     explicit ShearedRay(const Ray& ray);
 
+    // The axes alone: kz that of the direction's largest component, kx and ky in the order
+    // that keeps every triangle's winding.
+    struct Axes {
+        int kx, ky, kz;
+    };
+    static Axes axes_of(const Vec3& d) {
+        const double ax = std::abs(d.x), ay = std::abs(d.y), az = std::abs(d.z);
+        const int kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+        const int kx = kz == 2 ? 0 : kz + 1, ky = kx == 2 ? 0 : kx + 1;
+        // Looking down a negative axis mirrors the plane; swapping x and y mirrors it back, so
+        // that every triangle keeps its winding.
+        if (d[kz] < 0) return {ky, kx, kz};
+        return {kx, ky, kz};
+    }
+
     Vec3 origin;
     int kx, ky, kz;     // the axis of the direction's largest component is kz
     double sx, sy, sz;  // shear taking the direction to (0, 0, 1)

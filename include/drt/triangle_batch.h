@@ -28,6 +28,7 @@
 
 #include <immintrin.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -46,8 +47,14 @@ struct TriangleBatch {
 // The per-ray part of the filter: the ShearedRay's axes, origin and shear in float.
 class FloatShearedRay {
   public:
-    explicit FloatShearedRay(const ShearedRay& ray) : kx_(ray.kx), ky_(ray.ky), kz_(ray.kz) {
-        const std::array<double, 3> o{ray.origin[kx_], ray.origin[ky_], ray.origin[kz_]};
+    explicit FloatShearedRay(const ShearedRay& ray)
+        : FloatShearedRay(ray.origin, {ray.kx, ray.ky, ray.kz}, ray.sx, ray.sy, ray.sz) {}
+    // From the ray's origin, axes and shear, where the shear may also be off from the
+    // ShearedRay's by a few units of double rounding (d[kx] · (1 / d[kz]) for d[kx] / d[kz]):
+    // the bounds' 1 % margin covers that.
+    FloatShearedRay(const Vec3& origin, ShearedRay::Axes axes, double sx, double sy, double sz)
+        : kx_(axes.kx), ky_(axes.ky), kz_(axes.kz) {
+        const std::array<double, 3> o{origin[kx_], origin[ky_], origin[kz_]};
         double err = 0;
         for (int k = 0; k < 3; ++k) {
             const auto f = static_cast<float>(o[k]);
@@ -56,13 +63,15 @@ class FloatShearedRay {
             // Beyond this, products of coordinates could overflow before their bounds do.
             if (!(std::abs(f) <= kLargest)) usable_ = false;
         }
-        const auto sx = static_cast<float>(ray.sx), sy = static_cast<float>(ray.sy),
-                   sz = static_cast<float>(ray.sz);
-        if (!std::isfinite(sz) || sz == 0 || !(std::abs(sx) <= 1) || !(std::abs(sy) <= 1))
+        // (|sx|, |sy| ≤ 1 exactly; a product in place of the quotient may round just past 1.)
+        const auto fx = std::clamp(static_cast<float>(sx), -1.0f, 1.0f),
+                   fy = std::clamp(static_cast<float>(sy), -1.0f, 1.0f),
+                   fz = static_cast<float>(sz);
+        if (!std::isfinite(fz) || fz == 0 || !(std::abs(fx) <= 1) || !(std::abs(fy) <= 1))
             usable_ = false;
-        sx_ = _mm_set1_ps(sx);
-        sy_ = _mm_set1_ps(sy);
-        sz_ = _mm_set1_ps(sz);
+        sx_ = _mm_set1_ps(fx);
+        sy_ = _mm_set1_ps(fy);
+        sz_ = _mm_set1_ps(fz);
         // (Rounded up: err is exact in double, and at most 2^-24 of the origin.)
         twice_err_ = _mm_set1_ps(static_cast<float>(2 * err) * (1 + 0x1p-20f));
     }
