@@ -60,8 +60,8 @@ done
     echo "# Gallery"
     echo
     echo "Every thesis scene, single-effect figure and mesh scene of \`scenes/\`, rendered at its own settings"
-    echo "by \`tools/render-gallery.sh\` on $(nproc) cores ($(date -u +%F), commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown))."
-    echo "Times are wall-clock for the whole render on this machine; see docs/performance.md for"
+    echo "by \`tools/render-gallery.sh\` on $(nproc) cores of $(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n1) ($(date -u +%F), commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown))."
+    echo "Times are wall-clock for the whole render on this machine (compare them only with times from the same processor); see docs/performance.md for"
     echo "side-by-side measurements. Scene details: [scenes/README.md](../scenes/README.md)."
     echo
     cat "$body"
