@@ -50,6 +50,12 @@ void widen_to_share(int share) {
     (void)sched_setaffinity(0, sizeof mask, &mask);
 }
 
+// The worker threads of a process by default: its share of the machine's cores, which the
+// processes this job put on the machine divide among themselves.
+int share_of_machine(int local_processes) {
+    return std::max(1, worker_threads(0) / std::max(1, local_processes));
+}
+
 using Clock = std::chrono::steady_clock;
 
 // Message kinds between a process and the leader.
@@ -410,7 +416,7 @@ MpiJob::MpiJob() {
     // the machine (`-n 2` on two cores: one core each) the binding stays, and it kept 2 x 1
     // 2-8 % faster under load (docs/scale-out.md). Threads started from here on (workers, the
     // communication thread) inherit it; MPI's own, started already, barely run.
-    if (bound_by_mpirun_default()) widen_to_share(worker_threads(0) / std::max(1, local_size()));
+    if (bound_by_mpirun_default()) widen_to_share(share_of_machine(local_size()));
 }
 
 MpiJob::~MpiJob() = default;
@@ -426,10 +432,7 @@ int MpiJob::highest(int value) const {
 MpiShare MpiJob::render(const RenderContext& context, std::vector<Tile> todo, TileSink& sink,
                         const RenderOptions& options) const {
     RenderOptions run = options;
-    if (run.threads <= 0) {
-        // The machine's cores are shared by the processes this job put on it.
-        run.threads = std::max(1, worker_threads(0) / std::max(1, local_size()));
-    }
+    if (run.threads <= 0) run.threads = share_of_machine(local_size());
     if (leader()) {
         LeaderQueue queue(std::move(todo), options.stop);
         MpiShare share;
