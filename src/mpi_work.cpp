@@ -11,11 +11,13 @@
 #include <deque>
 #include <exception>
 #include <filesystem>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "drt/checkpoint.h"
 #include "drt/limits.h"
@@ -67,19 +69,47 @@ enum Tag : int {
 };
 
 // How long a communication thread sleeps while it waits for a message: at first short against
-// a tile's render time (milliseconds), then, while nothing comes, longer up to kIdleMost, so that
-// a quiet leader wakes a thousand times a second rather than five thousand. Each wake-up takes a
-// core from a worker on a machine with as many workers as cores: the polling of both ranks'
-// communication threads cost 2 x 1 thread about 0.5 s of system time in a 2.4 s render.
+// a tile's render time, then, while nothing comes, twice as long each time, up to a fraction of
+// the time between the finished tiles it handles (Pace). Each wake-up takes the core from a
+// worker on a machine with as many workers as cores, and on a virtual machine a timer costs an
+// exit to the host besides: polling every 100 µs to 1 ms, the leader of 2 x 1 thread on Test4
+// woke 2,000 times a second for tiles that take 110 ms.
 constexpr auto kIdleLeast = std::chrono::microseconds(100);
+// Before any tile has been timed, and where tiles are quick, the longest sleep; a thousandth of
+// a second is still short against a tile of a scene worth several processes.
 constexpr auto kIdleMost = std::chrono::microseconds(1000);
+// Where tiles are slow, the longest sleep: short against a person stopping the render.
+constexpr auto kIdleLongest = std::chrono::microseconds(20000);
 
-// Sleeps between polls: kIdleLeast after something happened, twice as long each time nothing did.
+// The time between the finished tiles a communication thread handles (smoothed), and so how
+// long it may sleep: a process asks for tiles while its workers still have one in hand, and the
+// leader's sleep and then the asking process's delay the answer by at most an eighth of that
+// time, short even against the cheap tiles that come last (costly_first).
+class Pace {
+  public:
+    void tick(Clock::time_point now) {
+        if (last_) {
+            const auto since = std::chrono::duration_cast<std::chrono::microseconds>(now - *last_);
+            interval_ = interval_.count() == 0 ? since : (3 * interval_ + since) / 4;
+        }
+        last_ = now;
+    }
+    std::chrono::microseconds longest_sleep() const {
+        return std::clamp<std::chrono::microseconds>(interval_ / 16, kIdleMost, kIdleLongest);
+    }
+
+  private:
+    std::optional<Clock::time_point> last_;
+    std::chrono::microseconds interval_{0};
+};
+
+// Sleeps between polls: kIdleLeast after something happened, twice as long each time nothing did,
+// up to what the pace allows.
 class Backoff {
   public:
-    void idle() {
+    void idle(const Pace& pace) {
         std::this_thread::sleep_for(wait_);
-        wait_ = std::min<std::chrono::microseconds>(2 * wait_, kIdleMost);
+        wait_ = std::min(2 * wait_, pace.longest_sleep());
     }
     void reset() { wait_ = kIdleLeast; }
 
@@ -99,7 +129,7 @@ class Doorbell {
         rang_.notify_one();
     }
     // Until rung or `most` has passed.
-    void wait(std::chrono::milliseconds most) {
+    void wait(std::chrono::microseconds most) {
         std::unique_lock lock(mutex_);
         rang_.wait_for(lock, most, [&] { return rung_; });
         rung_ = false;
@@ -221,10 +251,11 @@ void serve(const Transport& transport, const RenderContext& context, LeaderQueue
     const int processes = transport.size();
     int active = processes - 1;
     Backoff backoff;
+    Pace pace;
     while (active > 0) {
         const std::optional<Envelope> waiting = transport.poll(Transport::kAny, Transport::kAny);
         if (!waiting) {
-            backoff.idle();
+            backoff.idle(pace);
             continue;
         }
         backoff.reset();
@@ -239,6 +270,7 @@ void serve(const Transport& transport, const RenderContext& context, LeaderQueue
             }
             case kResult: {
                 const Clock::time_point start = Clock::now();
+                pace.tick(start);
                 const std::vector<unsigned char> bytes = transport.receive(from, kResult);
                 if (error) break;  // drain the others, but add nothing more
                 const Clock::time_point received = Clock::now();
@@ -348,14 +380,17 @@ class Outbox final : public TileSink {
 // Another process's communication thread: keeps `threads` tiles ahead of its workers, sends
 // their results, and once the workers have finished gives back what they did not take. Only a
 // grant comes to it, and only after a request, so it polls only while a request is unanswered
-// and otherwise sleeps until its workers ring `doorbell`.
+// and otherwise sleeps until its workers ring `doorbell`. Results leave without waiting for the
+// leader (send_later): a tile message is above Open MPI's shared-memory eager limit, and a
+// blocking send of one spun this thread, on the core its worker needs, until the leader's next
+// poll.
 void work_for_leader(const Transport& transport, const RenderContext& context, WorkerQueue& queue,
                      Outbox& outbox, int threads, const std::atomic<bool>& workers_finished,
                      Doorbell& doorbell, const std::stop_token& stop) {
-    // A bound on the sleep, for a stop (which rings no bell): short against a person waiting.
-    constexpr auto kLongest = std::chrono::milliseconds(20);
     Backoff backoff;
+    Pace pace;
     bool requested = false, dry = false;
+    std::vector<std::unique_ptr<Sending> > sending;
     const auto receive_grant = [&] {
         std::vector<Tile> tiles = receive_tiles(transport, context, 0, kGrant);
         requested = false;
@@ -365,9 +400,11 @@ void work_for_leader(const Transport& transport, const RenderContext& context, W
     const auto send_results = [&] {
         bool sent = false;
         while (std::optional<std::vector<unsigned char> > m = outbox.take()) {
-            transport.send(0, kResult, *m);
+            sending.push_back(transport.send_later(0, kResult, std::move(*m)));
+            pace.tick(Clock::now());
             sent = true;
         }
+        std::erase_if(sending, [](const std::unique_ptr<Sending>& s) { return s->sent(); });
         return sent;
     };
     for (;;) {
@@ -386,14 +423,18 @@ void work_for_leader(const Transport& transport, const RenderContext& context, W
             if (requested) receive_grant();  // answered in any case: take it to give it back
             send_results();
             send_tiles(transport, queue.drain(), 0, kDone);
+            while (!sending.empty()) {  // the leader takes them before the kDone sent after them
+                backoff.idle(pace);
+                send_results();
+            }
             return;
         }
         if (busy) {
             backoff.reset();
         } else if (requested) {
-            backoff.idle();
+            backoff.idle(pace);
         } else {
-            doorbell.wait(kLongest);
+            doorbell.wait(kIdleLongest);  // bounded for a stop, which rings no bell
         }
     }
 }

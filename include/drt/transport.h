@@ -17,6 +17,15 @@ struct Envelope {
     int tag = 0;
 };
 
+// A message on its way (Transport::send_later); it keeps its bytes until they have left.
+class Sending {
+  public:
+    // Destroyed before sent() said so, it waits for the message to leave.
+    virtual ~Sending() = default;
+    // True once the message has left this process; only looks, never waits.
+    virtual bool sent() = 0;
+};
+
 // Messages of bytes between the processes of one job, and the two collectives drt needs.
 // Implemented over MPI by the module (src/mpi_module/); at most one thread calls it at a time.
 class Transport {
@@ -32,7 +41,12 @@ class Transport {
     virtual int leaders(int value) const = 0;
     // The highest of every process's value, on every process.
     virtual int highest(int value) const = 0;
+    // Returns once `bytes` may be reused: for a message above MPI's eager limit (Open MPI's
+    // shared memory: 4 KB), only once the receiver has taken it, spinning a core meanwhile.
     virtual void send(int to, int tag, std::span<const unsigned char> bytes) const = 0;
+    // Starts sending `bytes` and returns at once, whatever the receiver is doing.
+    virtual std::unique_ptr<Sending> send_later(int to, int tag,
+                                                std::vector<unsigned char> bytes) const = 0;
     // The first message from `from` with `tag` (either may be kAny) if one is waiting; it stays
     // waiting.
     virtual std::optional<Envelope> poll(int from, int tag) const = 0;

@@ -5,6 +5,8 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "drt/transport.h"
 
@@ -21,6 +23,33 @@ int mpi_source(int from) {
 int mpi_tag(int tag) {
     return tag == Transport::kAny ? MPI_ANY_TAG : tag;
 }
+
+class MpiSending final : public Sending {
+  public:
+    MpiSending(int to, int tag, std::vector<unsigned char> bytes) : bytes_(std::move(bytes)) {
+        check(MPI_Isend(bytes_.data(), static_cast<int>(bytes_.size()), MPI_BYTE, to, tag,
+                        MPI_COMM_WORLD, &request_),
+              "send");
+    }
+    ~MpiSending() override {
+        // MPI reads bytes_ until the request completes. A destructor cannot throw: a failure
+        // here is MPI's, which ends the job anyway.
+        if (request_ != MPI_REQUEST_NULL) (void)MPI_Wait(&request_, MPI_STATUS_IGNORE);
+    }
+    MpiSending(const MpiSending&) = delete;
+    MpiSending& operator=(const MpiSending&) = delete;
+
+    bool sent() override {
+        if (request_ == MPI_REQUEST_NULL) return true;
+        int done = 0;
+        check(MPI_Test(&request_, &done, MPI_STATUS_IGNORE), "send");  // frees it when done
+        return done != 0;
+    }
+
+  private:
+    std::vector<unsigned char> bytes_;
+    MPI_Request request_ = MPI_REQUEST_NULL;
+};
 
 class MpiTransport final : public Transport {
   public:
@@ -59,6 +88,10 @@ class MpiTransport final : public Transport {
         check(MPI_Send(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, to, tag,
                        MPI_COMM_WORLD),
               "send");
+    }
+    std::unique_ptr<Sending> send_later(int to, int tag,
+                                        std::vector<unsigned char> bytes) const override {
+        return std::make_unique<MpiSending>(to, tag, std::move(bytes));
     }
     std::optional<Envelope> poll(int from, int tag) const override {
         int flag = 0;
