@@ -8,10 +8,10 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <utility>
 
 #include "drt/error_estimate.h"
+#include "drt/parallel.h"
 #include "drt/rng.h"
 
 namespace drt {
@@ -211,17 +211,12 @@ std::vector<Tile> costly_first(const RenderContext& context, std::vector<Tile> t
     // The pilot runs before any worker starts: spread over the threads, it keeps them waiting
     // for a share of it only.
     std::atomic<std::size_t> next{0};
-    const auto pilot = [&] {
-        for (std::size_t i = next++; i < tiles.size(); i = next++) {
+    const auto most = static_cast<int>(std::min<std::size_t>(tiles.size(), INT_MAX));
+    run_on_threads(std::min(threads, most), [&](const std::atomic<bool>& failed) {
+        for (std::size_t i = next++; i < tiles.size() && !failed.load(); i = next++) {
             costed[i] = {context.estimate_cost(tiles[i]), tiles[i]};
         }
-    };
-    {
-        std::vector<std::jthread> helpers;
-        const auto most = static_cast<int>(std::min<std::size_t>(tiles.size(), INT_MAX));
-        for (int h = 1; h < std::min(threads, most); ++h) helpers.emplace_back(pilot);
-        pilot();
-    }
+    });
     std::stable_sort(costed.begin(), costed.end(),
                      [](const auto& a, const auto& b) { return a.first > b.first; });
     for (std::size_t i = 0; i < tiles.size(); ++i) tiles[i] = costed[i].second;

@@ -3,13 +3,10 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
-#include <exception>
-#include <mutex>
-#include <thread>
-#include <vector>
+#include <functional>
 
 #include "drt/limits.h"
+#include "drt/parallel.h"
 
 namespace drt {
 
@@ -28,52 +25,20 @@ int render_tiles(const RenderContext& context, TileSource& source, TileSink& sin
     const int threads =
         std::max(1, std::min(worker_threads(options.threads), static_cast<int>(source.size())));
     std::atomic<std::size_t> tiles_done{0};
-    std::atomic<bool> failed{false};
-    std::exception_ptr error;  // the first one thrown; guarded by mutex
-    std::mutex mutex;
-    std::condition_variable finished;
-    int running = threads;
-    const auto fail = [&](std::exception_ptr e) {
-        const std::lock_guard lock(mutex);
-        if (!error) error = std::move(e);
-        failed.store(true);
-    };
-
-    auto worker = [&] {
-        try {
+    const double total = static_cast<double>(std::max<std::size_t>(1, source.size()));
+    const auto progress = [&] { options.on_progress(double(tiles_done.load()) / total); };
+    run_on_threads(
+        threads,
+        [&](const std::atomic<bool>& failed) {
             while (!failed.load(std::memory_order_relaxed) && !options.stop.stop_requested()) {
                 const std::optional<Tile> tile = source.next();
                 if (!tile) break;
                 sink.add(context.render_tile(*tile));
                 tiles_done.fetch_add(1, std::memory_order_relaxed);
             }
-        } catch (...) {
-            fail(std::current_exception());
-        }
-        const std::lock_guard lock(mutex);
-        if (--running == 0) finished.notify_all();
-    };
-
-    const double total = static_cast<double>(std::max<std::size_t>(1, source.size()));
-    {
-        std::vector<std::jthread> pool;
-        for (int id = 0; id < threads; ++id) pool.emplace_back(worker);
-        try {
-            std::unique_lock lock(mutex);
-            while (!finished.wait_for(lock, std::chrono::milliseconds(250),
-                                      [&] { return running == 0; })) {
-                if (options.on_progress) {
-                    lock.unlock();
-                    options.on_progress(double(tiles_done.load()) / total);
-                    lock.lock();
-                }
-            }
-        } catch (...) {  // from on_progress: the workers stop too
-            fail(std::current_exception());
-        }
-    }  // joins the workers
-    if (error) std::rethrow_exception(error);
-    if (options.on_progress) options.on_progress(double(tiles_done.load()) / total);
+        },
+        options.on_progress ? std::function<void()>(progress) : nullptr);
+    if (options.on_progress) progress();
     return threads;
 }
 

@@ -103,7 +103,7 @@ class RenderContext {
 // this order, the slow tiles start early and the render's tail, when some workers have nothing
 // left while others finish, is one cheap tile long rather than one costly one. A render of one
 // worker gains nothing from it and gets `tiles` back untouched. `threads` (this process's)
-// share the pilot.
+// share the pilot; an exception on any of them is rethrown here.
 std::vector<Tile> costly_first(const RenderContext& context, std::vector<Tile> tiles, int workers,
                                int threads = 1);
 

@@ -1,0 +1,21 @@
+// One function run on several threads at once, as the renderer's workers and the costly-first
+// pilot run: the caller waits, and an exception thrown on any thread comes back to it instead of
+// ending the program (an exception leaving a thread calls std::terminate).
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+
+namespace drt {
+
+// Runs `work` on `threads` new threads at once (at least one) and returns when all have
+// returned. `work` gets a flag that is set once any of them has thrown, so that the others can
+// end early. While it waits, the calling thread calls `waiting` (when given) every `interval`;
+// an exception from it sets the flag too. The first exception thrown, on any thread, is
+// rethrown here once every thread has ended.
+void run_on_threads(int threads, const std::function<void(const std::atomic<bool>& failed)>& work,
+                    const std::function<void()>& waiting = nullptr,
+                    std::chrono::milliseconds interval = std::chrono::milliseconds(250));
+
+}  // namespace drt
