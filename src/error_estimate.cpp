@@ -6,6 +6,8 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <tuple>
+#include <vector>
 
 namespace drt {
 
@@ -39,9 +41,50 @@ Color pixel_spread(std::span<const Color> samples) {
     return m2 / (double(n - 1) * double(n));
 }
 
+Color strata_spread(std::span<const Vec2> positions, std::span<const Color> samples) {
+    const std::size_t n = samples.size();
+    if (n < 2) return pixel_spread(samples);
+    const auto columns = std::max<std::size_t>(1, std::size_t(std::sqrt(double(n))));
+    const std::size_t rows = (n + columns - 1) / columns;
+    Color sum;
+    double terms = 0;
+    // (band, place along it, sample): sorted, the samples band by band (rows across x, or
+    // columns across y), each band in order along it; ties by index, so the order is a pure
+    // function of the samples.
+    std::vector<std::tuple<std::size_t, double, std::uint32_t>> order(n);
+    const auto differences = [&](std::size_t bands, auto across, auto along) {
+        for (std::uint32_t i = 0; i < n; ++i) {
+            const double t = std::max(0.0, across(positions[i])) * double(bands);
+            order[i] = {std::min(bands - 1, std::size_t(t)), along(positions[i]), i};
+        }
+        std::sort(order.begin(), order.end());
+        const auto value = [&](std::size_t k) { return samples[std::get<2>(order[k])]; };
+        for (std::size_t begin = 0; begin < n;) {
+            std::size_t end = begin + 1;
+            while (end < n && std::get<0>(order[end]) == std::get<0>(order[begin])) ++end;
+            if (end - begin == 2) {
+                const Color d = value(begin + 1) - value(begin);
+                sum += d * d / 2.0;
+                terms += 1;
+            }
+            for (std::size_t k = begin + 1; end - begin >= 3 && k + 1 < end; ++k) {
+                const Color d = value(k - 1) - 2.0 * value(k) + value(k + 1);
+                sum += d * d / 6.0;
+                terms += 1;
+            }
+            begin = end;
+        }
+    };
+    differences(rows, [](const Vec2& p) { return p.y; }, [](const Vec2& p) { return p.x; });
+    differences(columns, [](const Vec2& p) { return p.x; }, [](const Vec2& p) { return p.y; });
+    if (terms == 0) return pixel_spread(samples);
+    return sum / (terms * double(n));
+}
+
 double calibration_share(double pixels) {
     const double n = std::max(1.0, pixels);
-    return std::min(1.0, std::max(64 / n, std::min(kCalibrationShare, kMaxCalibrationPixels / n)));
+    return std::min(1.0, std::max(kMinSmallImageCalibration / n,
+                                  std::min(kCalibrationShare, kMaxCalibrationPixels / n)));
 }
 
 std::vector<double> calibration_odds(const Image& spread, double share) {

@@ -160,7 +160,14 @@ RenderContext::Pixel RenderContext::plain_pixel(int x, int y, std::uint64_t path
     integrator_.sample_pixel(x, y, s, scratch.colors, rays);
     Color sum;
     for (const Color& c : scratch.colors) sum += c;
-    return {sum / spp, pixel_spread(scratch.colors), spp, false};
+    if (sampler_->independent() || !plan_.effects.antialiasing || !estimate_error_) {
+        return {sum / spp, pixel_spread(scratch.colors), spp, false};
+    }
+    // The samples' places in the pixel, as the integrator drew them: the strata they fell in.
+    // Only for an estimate someone reads: it costs a sort of the samples.
+    scratch.positions.resize(spp);
+    sampler_->get_2d_run(s, dim::kPixel, scratch.positions);
+    return {sum / spp, strata_spread(scratch.positions, scratch.colors), spp, false};
 }
 
 // Rounds of as many samples as taken so far, until the standard error of the mean luminance is

