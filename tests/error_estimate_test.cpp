@@ -180,9 +180,10 @@ Scene small_scene(const std::string& file, const std::string& sampler, int spp,
 }
 
 // The estimate against the error measured against a 4096-spp sobol reference (its own error,
-// 1/64 of the renders' variance or less, taken out), for every sampler and three seeds. The
-// sample variance over n without the calibration (the stratified estimate before it) overstates
-// the stratified and sobol errors here 3.5-3.7x, which the test checks so that it keeps telling.
+// 1/64 of the renders' variance or less, taken out), for every sampler and three seeds. Without
+// the calibration the strata spread overstates the stratified and sobol errors here 2.0-2.2x
+// (edges count about twice; the sample variance over n did 3.5-3.7x), which the test checks so
+// that it keeps telling.
 TEST(EstimateError, WithinAQuarterOfTheTrueErrorOnAPenumbraAndEdges) {
     RenderOptions options;
     options.threads = 2;
@@ -201,7 +202,8 @@ TEST(EstimateError, WithinAQuarterOfTheTrueErrorOnAPenumbraAndEdges) {
             for (const float v : r.spread.rgb) spread += v;
             const double uncalibrated = std::sqrt(spread / double(r.spread.rgb.size())) / truth;
             if (sampler != "random") {
-                EXPECT_GT(uncalibrated, 3) << sampler << " seed " << seed;
+                EXPECT_GT(uncalibrated, 1.5) << sampler << " seed " << seed;
+                EXPECT_LT(uncalibrated, 3) << sampler << " seed " << seed;
             }
             EXPECT_GT(ratio, 0.8) << sampler << " seed " << seed;
             EXPECT_LT(ratio, 1.25) << sampler << " seed " << seed;
