@@ -75,8 +75,10 @@ Color strata_spread(std::span<const Vec2> positions, std::span<const Color> samp
             begin = end;
         }
     };
-    differences(rows, [](const Vec2& p) { return p.y; }, [](const Vec2& p) { return p.x; });
-    differences(columns, [](const Vec2& p) { return p.x; }, [](const Vec2& p) { return p.y; });
+    differences(
+        rows, [](const Vec2& p) { return p.y; }, [](const Vec2& p) { return p.x; });
+    differences(
+        columns, [](const Vec2& p) { return p.x; }, [](const Vec2& p) { return p.y; });
     if (terms == 0) return pixel_spread(samples);
     return sum / (terms * double(n));
 }
