@@ -44,6 +44,23 @@ TEST(StrataSpread, FirstDifferencesInBandsOfTwo) {
     EXPECT_TRUE(std::isinf(strata_spread(std::span(at).first(1), std::span(samples).first(1)).r));
 }
 
+TEST(StrataSpread, SecondDifferencesInBandsOfThree) {
+    // A 3 x 3 pixel, one sample a cell, value i^2 + 3 j^2 in cell (i, j) (red only).
+    std::vector<Vec2> at;
+    std::vector<Color> samples;
+    for (int j = 0; j < 3; ++j) {
+        for (int i = 0; i < 3; ++i) {
+            at.push_back({(i + 0.5) / 3, (j + 0.5) / 3});
+            samples.push_back({double(i * i + 3 * j * j), 0, 0});
+        }
+    }
+    // Rows: (0, 1, 4) + 3 j^2, each (0 - 2 + 4)^2 / 6; columns: (0, 3, 12) + i^2, each
+    // (0 - 6 + 12)^2 / 6; six terms, over n = 9.
+    const double terms = 3 * 4.0 / 6 + 3 * 36.0 / 6;
+    EXPECT_DOUBLE_EQ(strata_spread(at, samples).r, terms / 6 / 9);
+    EXPECT_EQ(strata_spread(at, samples).b, 0);
+}
+
 // The variance of a jittered 16 x 16 pixel's mean, over many patterns: what the strata spread
 // guesses on average, against the truth and the sample variance over n.
 struct Guesses {
