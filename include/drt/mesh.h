@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include "drt/math.h"
@@ -122,10 +123,12 @@ class TriangleMesh {
     // Turns the binary subtree at `node` into wide nodes appended to nodes_; returns the index
     // of the one made for `node`.
     std::uint32_t widen(const std::vector<BinaryNode>& binary, std::uint32_t node);
+    // What a query answers: whether any triangle is hit, or the nearest hit.
+    template <bool kAnyHit>
+    using Answer = std::conditional_t<kAnyHit, bool, std::optional<MeshHit>>;
     // `tests`, when given, counts the triangles tested.
     template <bool kAnyHit>
-    std::optional<MeshHit> traverse(const Ray& ray, Interval range,
-                                    std::uint64_t* tests = nullptr) const;
+    Answer<kAnyHit> traverse(const Ray& ray, Interval range, std::uint64_t* tests = nullptr) const;
 
     Vec3 origin_;
     std::vector<Float3> positions_;  // relative to origin_
