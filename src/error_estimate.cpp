@@ -41,7 +41,8 @@ Color pixel_spread(std::span<const Color> samples) {
     return m2 / (double(n - 1) * double(n));
 }
 
-Color strata_spread(std::span<const Vec2> positions, std::span<const Color> samples) {
+Color strata_spread(std::span<const Vec2> positions, std::span<const Color> samples,
+                    StrataScratch& scratch) {
     const std::size_t n = samples.size();
     if (n < 2) return pixel_spread(samples);
     const auto columns = std::max<std::size_t>(1, std::size_t(std::sqrt(double(n))));
@@ -51,7 +52,8 @@ Color strata_spread(std::span<const Vec2> positions, std::span<const Color> samp
     // (band, place along it, sample): sorted, the samples band by band (rows across x, or
     // columns across y), each band in order along it; ties by index, so the order is a pure
     // function of the samples.
-    std::vector<std::tuple<std::size_t, double, std::uint32_t>> order(n);
+    auto& order = scratch.order;
+    order.resize(n);
     const auto differences = [&](std::size_t bands, auto across, auto along) {
         for (std::uint32_t i = 0; i < n; ++i) {
             const double t = std::max(0.0, across(positions[i])) * double(bands);

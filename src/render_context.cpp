@@ -167,7 +167,8 @@ RenderContext::Pixel RenderContext::plain_pixel(int x, int y, std::uint64_t path
     // Only for an estimate someone reads: it costs a sort of the samples.
     scratch.positions.resize(spp);
     sampler_->get_2d_run(s, dim::kPixel, scratch.positions);
-    return {sum / spp, strata_spread(scratch.positions, scratch.colors), spp, false};
+    return {sum / spp, strata_spread(scratch.positions, scratch.colors, scratch.strata), spp,
+            false};
 }
 
 // Rounds of as many samples as taken so far, until the standard error of the mean luminance is

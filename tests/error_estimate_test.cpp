@@ -39,9 +39,11 @@ TEST(StrataSpread, FirstDifferencesInBandsOfTwo) {
     const std::vector<Color> samples{{1, 0, 0}, {2, 0, 0}, {4, 0, 0}, {8, 0, 0}};
     // Rows: (1, 2) and (4, 8); columns: (1, 4) and (2, 8).
     const double terms = (1.0 + 16 + 9 + 36) / 2;
-    EXPECT_DOUBLE_EQ(strata_spread(at, samples).r, terms / 4 / 4);
-    EXPECT_EQ(strata_spread(at, samples).g, 0);
-    EXPECT_TRUE(std::isinf(strata_spread(std::span(at).first(1), std::span(samples).first(1)).r));
+    StrataScratch scratch;
+    EXPECT_DOUBLE_EQ(strata_spread(at, samples, scratch).r, terms / 4 / 4);
+    EXPECT_EQ(strata_spread(at, samples, scratch).g, 0);
+    EXPECT_TRUE(
+        std::isinf(strata_spread(std::span(at).first(1), std::span(samples).first(1), scratch).r));
 }
 
 TEST(StrataSpread, SecondDifferencesInBandsOfThree) {
@@ -57,8 +59,9 @@ TEST(StrataSpread, SecondDifferencesInBandsOfThree) {
     // Rows: (0, 1, 4) + 3 j^2, each (0 - 2 + 4)^2 / 6; columns: (0, 3, 12) + i^2, each
     // (0 - 6 + 12)^2 / 6; six terms, over n = 9.
     const double terms = 3 * 4.0 / 6 + 3 * 36.0 / 6;
-    EXPECT_DOUBLE_EQ(strata_spread(at, samples).r, terms / 6 / 9);
-    EXPECT_EQ(strata_spread(at, samples).b, 0);
+    StrataScratch scratch;
+    EXPECT_DOUBLE_EQ(strata_spread(at, samples, scratch).r, terms / 6 / 9);
+    EXPECT_EQ(strata_spread(at, samples, scratch).b, 0);
 }
 
 // The variance of a jittered 16 x 16 pixel's mean, over many patterns: what the strata spread
@@ -75,6 +78,7 @@ Guesses guesses_on_jittered_grid(F&& f) {
     std::vector<Color> samples(at.size());
     double sum = 0, sum2 = 0;
     Guesses g;
+    StrataScratch scratch;
     for (int t = 0; t < kTrials; ++t) {
         double mean = 0;
         for (int i = 0; i < kSide * kSide; ++i) {
@@ -85,7 +89,7 @@ Guesses guesses_on_jittered_grid(F&& f) {
         }
         sum += mean;
         sum2 += mean * mean;
-        g.strata += strata_spread(at, samples).r / kTrials;
+        g.strata += strata_spread(at, samples, scratch).r / kTrials;
         g.sample += pixel_spread(samples).r / kTrials;
     }
     g.truth = sum2 / kTrials - (sum / kTrials) * (sum / kTrials);

@@ -25,6 +25,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "drt/color.h"
@@ -72,6 +73,13 @@ struct ErrorSums {
 // than two samples.
 Color pixel_spread(std::span<const Color> samples);
 
+// strata_spread's sort buffer, kept from pixel to pixel by its caller (one per thread) so that a
+// pixel's spread allocates nothing once the buffer has grown to the pixel's samples.
+struct StrataScratch {
+    // (band, place along it, sample index) of each sample, as strata_spread sorts them.
+    std::vector<std::tuple<std::size_t, double, std::uint32_t>> order;
+};
+
 // The spread of a stratified or Sobol pixel (the calibrated samplers): the variance of its mean
 // guessed from differences between neighbouring strata, per channel, from each sample's value and
 // position in the pixel (in [0, 1)^2). The pixel is cut into C = floor(sqrt(n)) columns and
@@ -84,7 +92,8 @@ Color pixel_spread(std::span<const Color> samples);
 // error about sqrt(n)-fold; an edge across a band counts about twice its variance, one along a
 // band once. The calibration then scales what is left (docs/accuracy.md). Infinite for fewer than
 // two samples.
-Color strata_spread(std::span<const Vec2> positions, std::span<const Color> samples);
+Color strata_spread(std::span<const Vec2> positions, std::span<const Color> samples,
+                    StrataScratch& scratch);
 
 // For each pixel of a tile (its spread image, row by row), the odds of rendering it a second
 // time: `share` on average over the tile, a quarter of them shared equally and the rest in

@@ -72,10 +72,11 @@ class RenderContext {
     };
     // Reused from pixel to pixel of a tile: the radiance of each camera sample of the pixel in
     // hand and their places in the pixel, and for adaptive sampling all the pixel's samples so
-    // far and their luminances.
+    // far and their luminances, and the strata spread's sort buffer.
     struct Scratch {
         std::vector<Color> colors;
         std::vector<Vec2> positions;
+        StrataScratch strata;
         std::vector<Color> taken;
         std::vector<double> luminances;
     };
