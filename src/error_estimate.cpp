@@ -93,12 +93,30 @@ double calibration_share(double pixels) {
 
 std::vector<double> calibration_odds(const Image& spread, double share) {
     constexpr double kShared = 0.25;
-    const std::size_t pixels = std::size_t(spread.width) * spread.height;
+    const int w = spread.width, h = spread.height;
+    const std::size_t pixels = std::size_t(w) * h;
+    std::vector<double> own(pixels);
+    for (std::size_t i = 0; i < pixels; ++i) {
+        own[i] = double(spread.rgb[3 * i]) + spread.rgb[3 * i + 1] + spread.rgb[3 * i + 2];
+    }
+    // The largest spread of the pixel and its neighbours: a pixel whose few samples all fell on
+    // one side of an edge shows no spread, though its neighbours along the edge do, and with
+    // odds by its own spread alone it was rarely rendered twice and then weighed 1 / odds in
+    // the sums: one such pixel made 83 % of the calibration's variance sum (soft-shadow-one-
+    // light, 48 x 36, sobol 4 spp, seed 14: estimate 2.3x the true error).
     std::vector<double> spreads(pixels);
     double total = 0;
-    for (std::size_t i = 0; i < pixels; ++i) {
-        spreads[i] = double(spread.rgb[3 * i]) + spread.rgb[3 * i + 1] + spread.rgb[3 * i + 2];
-        total += spreads[i];
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            double most = 0;
+            for (int ny = std::max(0, y - 1); ny <= std::min(h - 1, y + 1); ++ny) {
+                for (int nx = std::max(0, x - 1); nx <= std::min(w - 1, x + 1); ++nx) {
+                    most = std::max(most, own[std::size_t(ny) * w + nx]);
+                }
+            }
+            spreads[std::size_t(y) * w + x] = most;
+            total += most;
+        }
     }
     std::vector<double> odds(pixels, share);
     if (!(total > 0) || !std::isfinite(total)) return odds;

@@ -117,16 +117,25 @@ TEST(StrataSpread, GuessesAStratifiedPixelsVarianceWhereTheSampleVarianceCannot)
     EXPECT_GT(edge.sample / edge.truth, 20);
 }
 
-TEST(CalibrationOdds, AQuarterSharedAndTheRestByTheSpread) {
-    Image spread(4, 1);
-    spread.rgb = {0, 0, 0, 1, 1, 1, 0.5f, 0.25f, 0.25f, 1, 0.5f, 0.5f};  // sums 0, 3, 1, 2
+TEST(CalibrationOdds, AQuarterSharedAndTheRestByTheLargestSpreadAround) {
+    Image spread(5, 1);
+    // Sums 0, 3, 1, 0, 2; the largest of each pixel and its neighbours 3, 3, 3, 2, 2 (mean 2.6).
+    spread.rgb = {0, 0, 0, 1, 1, 1, 0.5f, 0.25f, 0.25f, 0, 0, 0, 1, 0.5f, 0.5f};
     const double f = 0.1;
     const std::vector<double> odds = calibration_odds(spread, f);
-    ASSERT_EQ(odds.size(), 4u);
-    EXPECT_DOUBLE_EQ(odds[0], f * 0.25);
-    EXPECT_DOUBLE_EQ(odds[1], f * (0.25 + 0.75 * 3 / 1.5));
-    EXPECT_DOUBLE_EQ(odds[2], f * (0.25 + 0.75 * 1 / 1.5));
-    EXPECT_DOUBLE_EQ(odds[3], f * (0.25 + 0.75 * 2 / 1.5));
+    ASSERT_EQ(odds.size(), 5u);
+    EXPECT_DOUBLE_EQ(odds[0], f * (0.25 + 0.75 * 3 / 2.6));
+    EXPECT_DOUBLE_EQ(odds[1], odds[0]);
+    EXPECT_DOUBLE_EQ(odds[2], odds[0]);
+    EXPECT_DOUBLE_EQ(odds[3], f * (0.25 + 0.75 * 2 / 2.6));
+    EXPECT_DOUBLE_EQ(odds[4], odds[3]);
+    // In two dimensions the diagonal neighbours count too: a spread of 4 at (0, 0) of a 4 x 3
+    // image reaches (1, 0), (0, 1) and (1, 1) (mean 16 / 12), and no further.
+    Image corner(4, 3);
+    corner.rgb[0] = 4;
+    const std::vector<double> near = calibration_odds(corner, f);
+    for (const int i : {0, 1, 4, 5}) EXPECT_DOUBLE_EQ(near[i], f * (0.25 + 0.75 * 3)) << i;
+    for (const int i : {2, 3, 6, 7, 8, 9, 10, 11}) EXPECT_DOUBLE_EQ(near[i], f * 0.25) << i;
     // No spread anywhere: the same odds everywhere.
     EXPECT_EQ(calibration_odds(Image(2, 2), f), std::vector<double>(4, f));
     // 8 % of an image, but at least 512 pixels, or all of them.
@@ -136,6 +145,69 @@ TEST(CalibrationOdds, AQuarterSharedAndTheRestByTheSpread) {
     // Not more than 4096 pixels of a large one.
     EXPECT_EQ(calibration_share(51200), kCalibrationShare);
     EXPECT_DOUBLE_EQ(calibration_share(800 * 600) * 800 * 600, 4096);
+}
+
+// A 16 x 16 tile of 4-sample stratified pixels (2 x 2 jittered) cut by a slanted edge, value 1
+// left of it and 0 right, calibrated as a 48 x 36 image is (30 % of its pixels rendered twice on
+// average): the estimated variance of the tile (the scale times the spreads) against the true
+// one (the variance of each pixel's mean over the trials). A cut pixel whose four samples fall on
+// one side shows no spread; with odds by its own spread it was rarely rendered twice and then
+// dominated the sums by its weight 1 / odds, so the estimate scattered over the trials.
+TEST(CalibrationOdds, AnEdgePixelWithoutSpreadDoesNotScatterTheEstimate) {
+    constexpr int kSide = 16, kTrials = 3000;
+    constexpr double kShare = 0.3;
+    std::mt19937_64 random(11);
+    std::uniform_real_distribution<double> uniform;
+    const auto render = [&](int x, int y, std::vector<Vec2>& at, std::vector<Color>& samples) {
+        double sum = 0;
+        for (int k = 0; k < 4; ++k) {
+            at[k] = {(k % 2 + uniform(random)) / 2, (k / 2 + uniform(random)) / 2};
+            const double v = x + at[k].x < 3.3 + 0.61 * (y + at[k].y) ? 1 : 0;
+            samples[k] = {v, v, v};
+            sum += v;
+        }
+        return sum / 4;
+    };
+    std::vector<Vec2> at(4);
+    std::vector<Color> samples(4);
+    StrataScratch scratch;
+    std::vector<double> mean(kSide * kSide), mean2(kSide * kSide), estimates;
+    Image first(kSide, kSide), spread(kSide, kSide);
+    for (int t = 0; t < kTrials; ++t) {
+        for (int y = 0; y < kSide; ++y) {
+            for (int x = 0; x < kSide; ++x) {
+                const double m = render(x, y, at, samples);
+                first.set(x, y, {m, m, m});
+                spread.set(x, y, strata_spread(at, samples, scratch));
+                mean[y * kSide + x] += m / kTrials;
+                mean2[y * kSide + x] += m * m / kTrials;
+            }
+        }
+        const std::vector<double> odds = calibration_odds(spread, kShare);
+        ErrorSums sums;
+        double spreads = 0;
+        for (int i = 0; i < kSide * kSide; ++i) {
+            const Color s{spread.rgb[3 * i], spread.rgb[3 * i + 1], spread.rgb[3 * i + 2]};
+            spreads += s.r + s.g + s.b;
+            if (uniform(random) >= odds[i]) continue;
+            const double again = render(i % kSide, i / kSide, at, samples);
+            const Color f{first.rgb[3 * i], first.rgb[3 * i + 1], first.rgb[3 * i + 2]};
+            add_calibration(sums, f, {again, again, again}, s, odds[i], 4);
+        }
+        estimates.push_back(sums.variance / sums.spread * spreads);
+    }
+    double truth = 0;
+    for (int i = 0; i < kSide * kSide; ++i) truth += 3 * (mean2[i] - mean[i] * mean[i]);
+    double log_sum = 0, log_sum2 = 0;
+    for (const double e : estimates) {
+        log_sum += std::log(e / truth) / kTrials;
+        log_sum2 += std::pow(std::log(e / truth), 2) / kTrials;
+    }
+    const double scatter = std::sqrt(log_sum2 - log_sum * log_sum);
+    // Measured: mean log ratio -0.05, scatter 0.34; with odds by the pixel's own spread alone
+    // (before 2026-12-02 19:30) mean off by 0.19, scatter 0.58.
+    EXPECT_LT(std::abs(log_sum), 0.1);
+    EXPECT_LT(scatter, 0.45);
 }
 
 TEST(EstimateError, OneSampleAndTooFewCalibratedPixelsAreNotANumber) {

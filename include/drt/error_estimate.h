@@ -8,8 +8,8 @@
 // overstated the error by 1.3 to 10x (docs/accuracy.md); their spread is the strata spread
 // (strata_spread), from differences of neighbouring strata, which credits the stratification but
 // cannot see correlations between strata. There the spread only says where the error is, and the
-// image calibrates how large it is: a few pixels of each tile, chosen at random
-// with odds that grow with their spread (calibration_odds), are rendered a second time with an
+// image calibrates how large it is: a few pixels of each tile, chosen at random with odds that
+// grow with the spread around them (calibration_odds), are rendered a second time with an
 // independent pattern of the same sampler and count. Half the squared difference of the two
 // means has the variance of the mean as its expectation, whatever the pattern; summed over the
 // chosen pixels, each weighted by 1 / its odds, against the same weighted sum of their spreads,
@@ -97,9 +97,11 @@ Color strata_spread(std::span<const Vec2> positions, std::span<const Color> samp
 
 // For each pixel of a tile (its spread image, row by row), the odds of rendering it a second
 // time: `share` on average over the tile, a quarter of them shared equally and the rest in
-// proportion to the pixel's spread, at most 1. Pixels where the samples spread more
-// carry most of the error, so the calibration looks there most often; every pixel keeps some
-// odds, so the weighted sums stay unbiased.
+// proportion to the largest spread of the pixel and its (up to 8) neighbours in the tile, at
+// most 1. Pixels where the samples spread more carry most of the error, so the calibration looks
+// there most often; the neighbours count because a pixel of few samples can miss the edge that
+// crosses it (no spread, yet a large error) while its neighbours along the edge show it. Every
+// pixel keeps some odds, so the weighted sums stay unbiased.
 std::vector<double> calibration_odds(const Image& spread, double share);
 
 // Adds a pixel rendered twice: `first` the image's mean and `spread` its spread, `second` the
