@@ -58,14 +58,18 @@ constexpr OrderList kOrders = [] {
     return list;
 }();
 
+// A uniformly random one of the listed orders of 0 .. size-1, size <= kListedOrders.
+std::uint32_t listed_order(std::uint32_t size, Digits& digits) {
+    const std::uint32_t start = kOrderListStart[size];
+    return kOrders[start + digits.below(kOrderListStart[size + 1] - start)];
+}
+
 // A uniformly random order of 0 .. out.size()-1: one of the listed orders when they are few,
 // else dealt by Fisher-Yates.
 void shuffle(std::span<std::uint32_t> out, Digits& digits) {
     const auto size = static_cast<std::uint32_t>(out.size());
     if (size <= kListedOrders) {
-        const std::uint32_t start = kOrderListStart[size];
-        const std::uint32_t order =
-            kOrders[start + digits.below(kOrderListStart[size + 1] - start)];
+        const std::uint32_t order = listed_order(size, digits);
         for (std::uint32_t c = 0; c < size; ++c) out[c] = (order >> (4 * c)) & 15u;
         return;
     }
@@ -114,6 +118,36 @@ Shape shape_for(std::uint32_t k) {
     return shape_of(k, std::max(1u, static_cast<std::uint32_t>(std::sqrt(double(k)))));  // floor
 }
 
+// The grids whose sides both have at most kListedOrders elements, k <= 25, keep each side's
+// order as the listed word of hexadecimal digits. Where stratum s = row * m + col of such a grid
+// finds its column's and its row's digit: the shifts 4 col (the low byte) and 4 row (the next),
+// for s < k and again at s + k, so that a rotated run of strata reads them in order, in a loop
+// that vectorises (the cells of a small set tabulated one by one cost as much as its points:
+// docs/performance.md, ninth round). 32-bit entries: narrower ones keep the loop from vectorising.
+constexpr std::uint32_t kPackedUpTo = kListedOrders * kListedOrders;
+using Places = std::array<std::uint32_t, 2 * kPackedUpTo>;
+constexpr std::array<Places, kPackedUpTo + 1> kPlaces = [] {
+    std::array<Places, kPackedUpTo + 1> places{};
+    for (std::uint32_t k = 1; k <= kPackedUpTo; ++k) {
+        const std::uint32_t m = kShapes[k].m;
+        for (std::uint32_t j = 0; j < 2 * k; ++j) {
+            places[k][j] = 4 * (j % k % m) | 4 * (j % k / m) << 8;
+        }
+    }
+    return places;
+}();
+
+// The cell column * n + sub_column of the stratum at `place` of a grid whose sides are packed.
+struct PackedSides {
+    std::uint32_t columns, sub_columns, n;
+    const std::uint32_t* places;
+
+    std::uint32_t cell(std::uint32_t place) const {
+        const std::uint32_t shifts = places[place];
+        return ((columns >> (shifts & 255u)) & 15u) * n + ((sub_columns >> (shifts >> 8)) & 15u);
+    }
+};
+
 // The grid of a pattern of k points keyed by `key`, its shuffled columns and sub-columns, the
 // jitters' key and a set's rotation: what every point of the pattern shares.
 //
@@ -142,20 +176,29 @@ class Grid {
     Shape shape;
     std::uint64_t jitter_key;
     std::uint32_t rotation;
+    // Both sides listed: their orders packed, and `column` and `sub_column` left empty.
+    bool packed;
+    PackedSides packed_sides{};
     std::span<std::uint32_t> column, sub_column;
 
     Grid(std::uint32_t k_, std::uint32_t key)
         : k(k_),
           shape(shape_for(k_)),
-          column(side(column_small_, column_large_, shape.m)),
-          sub_column(side(sub_column_small_, sub_column_large_, shape.n)) {
+          packed(shape.m <= kListedOrders && shape.n <= kListedOrders) {
         const std::uint64_t h = mix64(key ^ 0x7f4a7c159e3779b9ULL);
         jitter_key = mix64(h);
         Digits digits(static_cast<std::uint32_t>(h >> 32), h ^ 0x68bc21ebu);
-        if (k <= kDealtUpTo) {
+        if (packed) {
+            const std::uint32_t columns = listed_order(shape.m, digits);
+            packed_sides = {columns, listed_order(shape.n, digits), shape.n, kPlaces[k].data()};
+        } else if (k <= kDealtUpTo) {
+            column = side(column_small_, column_large_, shape.m);
+            sub_column = side(sub_column_small_, sub_column_large_, shape.n);
             shuffle(column, digits);
             shuffle(sub_column, digits);
         } else {
+            column = side(column_small_, column_large_, shape.m);
+            sub_column = side(sub_column_small_, sub_column_large_, shape.n);
             for (std::uint32_t c = 0; c < shape.m; ++c) {
                 column[c] = permute(c, shape.m, key * 0x68bc21ebu);
             }
@@ -170,6 +213,7 @@ class Grid {
 
     // The cell of stratum s = row * m + col: column[col] * n + sub_column[row].
     std::uint32_t cell(std::uint32_t s) const {
+        if (packed) return packed_sides.cell(s);
         return column[s % shape.m] * shape.n + sub_column[s / shape.m];
     }
 };
@@ -187,6 +231,10 @@ class Cells {
         const std::uint32_t k = grid.k, m = grid.shape.m, n = grid.shape.n;
         if (k > kSmall) large_.resize(k);
         cells_ = k > kSmall ? large_.data() : small_.data();
+        if (grid.packed) {
+            for (std::uint32_t s = 0; s < k; ++s) cells_[s] = grid.packed_sides.cell(s);
+            return;
+        }
         for (std::uint32_t row = 0, s = 0; s < k; ++row) {
             const std::uint32_t sub_column = grid.sub_column[row];
             for (std::uint32_t col = 0; col < m && s < k; ++col, ++s) {
@@ -237,6 +285,16 @@ DRT_VECTORISED void rotated_points(const Jitter& jitter, const std::uint32_t* ce
         std::uint32_t s = start + static_cast<std::uint32_t>(i);
         s = s < k ? s : s - k;
         out[i] = jitter.point(s, cells[s]);
+    }
+}
+
+// rotated_points for a grid whose sides are packed, the cells worked out with the points.
+DRT_VECTORISED void packed_rotated_points(const Jitter& jitter, const PackedSides& sides,
+                                          std::uint32_t start, std::uint32_t k, Vec2* out,
+                                          std::size_t count) {
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::uint32_t place = start + static_cast<std::uint32_t>(i);
+        out[i] = jitter.point(place < k ? place : place - k, sides.cell(place));
     }
 }
 
@@ -296,16 +354,26 @@ Vec2 multi_jittered(std::uint32_t j, std::uint32_t k, std::uint32_t key) {
 void multi_jittered_set(std::uint32_t first, std::uint32_t k, std::uint32_t key,
                         std::span<Vec2> out) {
     const Grid grid(k, key);
-    const Cells cells(grid);
     const Jitter jitter(grid);
     // At most k points at a time, so that the strata wrap around at most once. (Sets are drawn
     // at every shading point: the remainders are taken only when they can differ from a compare.)
-    for (std::size_t done = 0; done < out.size(); done += k) {
-        const std::uint32_t at = first + static_cast<std::uint32_t>(done);
-        std::uint32_t start = (at < k ? at : at % k) + grid.rotation;
-        if (start >= k) start -= k;
-        rotated_points(jitter, cells.data(), start, k, out.data() + done,
-                       std::min<std::size_t>(k, out.size() - done));
+    const auto passes = [&](const auto& points) {
+        for (std::size_t done = 0; done < out.size(); done += k) {
+            const std::uint32_t at = first + static_cast<std::uint32_t>(done);
+            std::uint32_t start = (at < k ? at : at % k) + grid.rotation;
+            if (start >= k) start -= k;
+            points(start, out.data() + done, std::min<std::size_t>(k, out.size() - done));
+        }
+    };
+    if (grid.packed) {
+        passes([&](std::uint32_t start, Vec2* to, std::size_t count) {
+            packed_rotated_points(jitter, grid.packed_sides, start, k, to, count);
+        });
+    } else {
+        const Cells cells(grid);
+        passes([&](std::uint32_t start, Vec2* to, std::size_t count) {
+            rotated_points(jitter, cells.data(), start, k, to, count);
+        });
     }
 }
 

@@ -19,10 +19,11 @@ using testing::in_unit;
 using testing::multi_jittered_strata;
 using testing::uniform_by_ks;
 
-// Square, rectangular (k = m*n) and ragged counts, and counts past the dealt shuffles (1024) and
-// the small grid sides (64).
-const std::uint32_t kCounts[] = {1,  2,  3,  4,  5,   7,   9,    10,   12,   16,
-                                 17, 20, 64, 82, 100, 256, 1000, 1025, 1500, 4100};
+// Square, rectangular (k = m*n) and ragged counts, the largest grids whose sides are both listed
+// orders (20, 25) and one between them whose rows are dealt (24), and counts past the dealt
+// shuffles (1024) and the small grid sides (64).
+const std::uint32_t kCounts[] = {1,  2,  3,  4,  5,  7,   9,   10,   12,   16,   17,
+                                 20, 24, 25, 64, 82, 100, 256, 1000, 1025, 1500, 4100};
 
 std::vector<Vec2> run_of(std::uint32_t k, std::uint32_t key) {
     std::vector<Vec2> points(k);
