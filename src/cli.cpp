@@ -215,14 +215,19 @@ std::string json_string(const std::string& s) {
 
 // The rounds of a render to a goal (--target-error, --time-limit).
 std::string goal_json(const ProgressiveResult& p, const std::optional<double>& target,
-                      const std::optional<double>& limit) {
+                      const std::optional<double>& limit, std::uint64_t seed) {
     std::ostringstream j;
     j << "  \"goal\": {\"target_error\": " << (target ? json_number(*target) : "null")
       << ", \"time_limit\": " << (limit ? json_number(*limit) : "null")
-      << ", \"target_met\": " << json_bool(p.target_met) << ", \"rounds\": [";
+      << ", \"target_met\": " << json_bool(p.target_met)
+      << ", \"combined\": " << json_bool(p.combined) << ", \"rounds\": [";
     for (std::size_t i = 0; i < p.rounds.size(); ++i) {
         const ProgressiveRound& r = p.rounds[i];
-        j << (i ? ", " : "") << "{\"spp\": " << r.spp << ", \"seconds\": " << json_number(r.seconds)
+        j << (i ? ", " : "") << "{\"spp\": " << r.spp;
+        // The seed renders the round alone (--spp N --seed S): a string, as 64 bits are beyond
+        // a JSON number's exact range.
+        if (p.combined) j << ", \"seed\": \"" << round_seed(seed, i) << "\"";
+        j << ", \"seconds\": " << json_number(r.seconds)
           << ", \"estimated_rmse\": " << (r.error ? json_number(*r.error) : "null") << "}";
     }
     j << "]},\n";
@@ -434,8 +439,16 @@ std::string goal_summary(const std::string& name, const ProgressiveResult& p, co
         line << "; " << std::fixed << std::setprecision(2) << seconds << " s of the "
              << short_number(*goal.time_limit) << " s limit" << std::defaultfloat;
     }
-    line << "\ndrt: " << name << ": --spp " << p.samples
-         << " renders the same image (bit-identical) without a goal\n";
+    if (!p.combined) {
+        line << "\ndrt: " << name << ": --spp " << p.samples
+             << " renders the same image (bit-identical) without a goal\n";
+    } else if (goal.time_limit) {
+        line << "\ndrt: " << name << ": the rounds' images combined, weighted by their counts; "
+             << "the same command renders the same image where it completes the same rounds\n";
+    } else {
+        line << "\ndrt: " << name << ": the rounds' images combined, weighted by their counts; "
+             << "the same command renders the same image (bit-identical) every run\n";
+    }
     return line.str();
 }
 
@@ -568,7 +581,8 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
     }
     outcome.json = stats_json(
         scene, result,
-        rounds ? goal_json(*rounds, job.goal.target_error, job.goal.time_limit) : std::string());
+        rounds ? goal_json(*rounds, job.goal.target_error, job.goal.time_limit, scene.settings.seed)
+               : std::string());
     if (!job.error_image.empty()) {
         try {
             write_image(standard_error_image(result.spread, result.stats.error), job.error_image,
@@ -596,9 +610,10 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
         if (rounds) err << goal_summary(name, *rounds, job.goal, outcome.seconds);
     }
     if (rounds && rounds->stopped) {
-        // Interrupted between or during rounds: the image is the last complete round's.
+        // Interrupted between or during rounds: the image is the complete rounds'.
         const int sig = stop_signal().load();
-        err << "drt: " << name << ": interrupted; kept the last complete round\n";
+        err << "drt: " << name << ": interrupted; kept "
+            << (rounds->combined ? "the complete rounds combined\n" : "the last complete round\n");
         outcome.status = job.agree(sig != 0 ? 128 + sig : kInterrupted);
         return outcome;
     }
@@ -962,7 +977,8 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
 // for its final round.
 struct GoalForecast {
     std::vector<ProgressiveRound> pilots;
-    std::optional<Prediction> prediction;
+    int final_round = 0;              // the final round's count; 0 when the pilots reach it
+    std::optional<Prediction> total;  // all rounds together
 };
 
 GoalForecast forecast(Scene& scene, double target, int threads) {
@@ -976,11 +992,15 @@ GoalForecast forecast(Scene& scene, double target, int threads) {
     const ProgressiveResult pilots = render_progressively(scene, options, goal);
     f.pilots = pilots.rounds;
     if (pilots.rounds.empty()) return f;
+    double seconds = 0;
+    for (const ProgressiveRound& r : pilots.rounds) seconds += r.seconds;
     const NextRound last = next_round(pilots.rounds, target, kMaxSamples);
     if (last.spp == 0) {
-        f.prediction = Prediction{pilots.samples, pilots.rounds.back().seconds};
+        f.total = Prediction{pilots.samples, seconds};
     } else if (last.final) {
-        f.prediction = Prediction{last.spp, predicted_seconds(pilots.rounds, last.spp)};
+        f.final_round = last.spp;
+        f.total = Prediction{pilots.samples + last.spp,
+                             seconds + predicted_seconds(pilots.rounds, last.spp)};
     }
     return f;
 }
@@ -994,15 +1014,14 @@ std::string forecast_text(const GoalForecast& f, double target) {
              << (r.error ? short_number(*r.error) : std::string("n/a")) << ";";
     }
     text << "\npredicted for --target-error " << short_number(target) << ": ";
-    if (f.prediction) {
-        // The goal render repeats the pilots before its own rounds.
-        double pilots = 0;
-        for (const ProgressiveRound& r : f.pilots) pilots += r.seconds;
-        const bool more = f.prediction->spp > f.pilots.back().spp;
-        text << f.prediction->spp << " spp, " << std::fixed << std::setprecision(2)
-             << pilots + (more ? f.prediction->seconds : 0) << " s on this machine (--spp "
-             << f.prediction->spp << " alone: " << f.prediction->seconds << " s)"
-             << std::defaultfloat;
+    if (f.total) {
+        // The goal render repeats the pilots, then adds the final round to them.
+        text << f.total->spp << " spp, " << std::fixed << std::setprecision(2) << f.total->seconds
+             << " s on this machine (rounds of " << std::defaultfloat;
+        for (const ProgressiveRound& r : f.pilots)
+            text << (&r == &f.pilots[0] ? "" : ", ") << r.spp;
+        if (f.final_round > 0) text << ", " << f.final_round;
+        text << " spp)";
     } else {
         text << "n/a (the pilots give no error estimate to extrapolate)";
     }

@@ -6,7 +6,11 @@
 #include <limits>
 #include <mutex>
 #include <stop_token>
+#include <string>
 #include <thread>
+#include <vector>
+
+#include "drt/rng.h"
 
 namespace drt {
 
@@ -27,11 +31,13 @@ constexpr double kIndependentSlope = -0.5;
 // Of the time left, what a round may be predicted to take: the rest absorbs the prediction's
 // error.
 constexpr double kTimeShare = 0.9;
-// Predicted counts are raised by this much: a round that misses the target costs a whole
-// round more.
-constexpr double kSpare = 1.05;
-// A round after a final round that missed: at least this many times its count.
-constexpr double kRetryGrowth = 1.1;
+// A round adds at least this share of the samples so far: a smaller one is not worth its
+// set-up.
+constexpr double kMinAddedShare = 0.1;
+// The fewest samples of a round with an error estimate.
+constexpr int kMinRound = 2;
+// Keeps round_seed's streams apart from other hashes of the seed.
+constexpr std::uint64_t kRoundStream = 0x726f756e64ULL;
 
 // The image's estimated RMSE, where the render can estimate it.
 std::optional<double> estimated_error(const RenderResult& r) {
@@ -72,6 +78,69 @@ class Alarm {
     std::jthread thread_;
 };
 
+// The rounds of a render to a target error added up: each pixel the mean of the rounds' values
+// weighted by round_weight, and the variance of that mean, the rounds' variances (spread x
+// scale) times their weights squared. Sums in double, in round order: the same bits however the
+// rounds were rendered.
+class Combination {
+  public:
+    Combination(int width, int height)
+        : width_(width),
+          height_(height),
+          sum_(3 * std::size_t(width) * height),
+          variance_(sum_.size()) {}
+
+    void add(const RenderResult& r, int spp) {
+        const double scale = r.stats.error.available() ? r.stats.error.scale : 0;
+        const double weight = round_weight(r.stats.error.rmse, spp);
+        for (std::size_t i = 0; i < sum_.size(); ++i) {
+            sum_[i] += weight * r.image.rgb[i];
+            variance_[i] += weight * weight * scale * r.spread.rgb[i];
+        }
+        weights_ += weight;
+        samples_ += spp;
+        stats_.rays += r.stats.rays;
+        stats_.samples += r.stats.samples;
+        stats_.seconds += r.stats.seconds;
+        calibration_ += r.stats.error.cost * double(r.stats.samples);
+        if (!r.stats.error.available()) unavailable_ = r.stats.error.unavailable;
+    }
+
+    // The image so far, with `last`'s plan and per-process figures.
+    RenderResult result(const RenderResult& last) const {
+        RenderResult out;
+        out.plan = last.plan;
+        out.stats = stats_;
+        out.stats.threads = last.stats.threads;
+        out.stats.processes = last.stats.processes;
+        out.stats.tail_seconds = last.stats.tail_seconds;
+        out.image = Image(width_, height_);
+        out.spread = Image(width_, height_);
+        const double n = weights_;
+        for (std::size_t i = 0; i < sum_.size(); ++i) {
+            out.image.rgb[i] = static_cast<float>(sum_[i] / n);
+            out.spread.rgb[i] = static_cast<float>(variance_[i] / (n * n));
+        }
+        if (unavailable_.empty()) {
+            out.stats.error = estimate_error(out.image, out.spread, ErrorSums{}, stats_.samples,
+                                             samples_, SpreadKind::kIndependent);
+            out.stats.error.cost = stats_.samples > 0 ? calibration_ / stats_.samples : 0;
+        } else {
+            out.stats.error.unavailable = unavailable_;
+        }
+        return out;
+    }
+
+  private:
+    int width_, height_;
+    std::vector<double> sum_, variance_;  // per channel: sum of weight x value, weight^2 x variance
+    double weights_ = 0;
+    int samples_ = 0;
+    RenderStats stats_;
+    double calibration_ = 0;   // camera samples the rounds' calibrations took
+    std::string unavailable_;  // why a round had no estimate
+};
+
 }  // namespace
 
 double predicted_seconds(const std::vector<ProgressiveRound>& rounds, int spp) {
@@ -80,35 +149,66 @@ double predicted_seconds(const std::vector<ProgressiveRound>& rounds, int spp) {
     return line.setup + line.per_sample * spp;
 }
 
+std::uint64_t round_seed(std::uint64_t seed, std::size_t round) {
+    return round == 0 ? seed : hash_of(seed, kRoundStream, std::uint64_t{round});
+}
+
+double round_weight(const std::optional<double>& error, int spp) {
+    return error && *error > 0 && std::isfinite(*error) ? 1 / (*error * *error) : spp;
+}
+
+int total_samples(const std::vector<ProgressiveRound>& rounds) {
+    int total = 0;
+    for (const ProgressiveRound& r : rounds) total += r.spp;
+    return total;
+}
+
 std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, double target,
                                   int max_samples, double steepest) {
     std::vector<const ProgressiveRound*> measured;
     for (const ProgressiveRound& r : rounds) {
         if (r.error && *r.error > 0 && std::isfinite(*r.error)) measured.push_back(&r);
     }
-    if (measured.empty()) return std::nullopt;
+    const std::optional<double> now = rounds.back().combined;
+    if (measured.empty() || !now) return std::nullopt;
+    // The largest round's error is the least noisy to extrapolate from, and the largest of
+    // those at most a kMinSlopeSpan-th of its count gives the slope: over a narrower span the
+    // errors' noise decides it. Stable sorts keep the latest of equal counts last.
+    std::stable_sort(measured.begin(), measured.end(),
+                     [](const auto* x, const auto* y) { return x->spp < y->spp; });
     const ProgressiveRound& b = *measured.back();
-    double slope = kIndependentSlope;
-    // The latest earlier round kMinSlopeSpan times fewer: over a narrower span (a final round
-    // that just missed after one only a little smaller) the errors' noise decides the slope.
+    double slope = steepest;
     const auto a = std::find_if(measured.rbegin() + 1, measured.rend(),
                                 [&](const auto* r) { return r->spp * kMinSlopeSpan <= b.spp; });
     if (a != measured.rend()) {
         slope = std::clamp(std::log(*b.error / *(*a)->error) / std::log(double(b.spp) / (*a)->spp),
                            steepest, -0.25);
     }
-    double spp = b.spp;
-    if (*b.error > target) spp = b.spp * std::pow(target / *b.error, 1 / slope) * kSpare;
-    const int count = static_cast<int>(std::clamp(std::ceil(spp), 1.0, double(max_samples)));
+    const double total = total_samples(rounds);
+    const double left = max_samples - total;
+    if (*now <= target || left < kMinRound) return Prediction{0, 0};
+    // Rounds weighted by the inverse of their estimated variance combine to 1 / c^2, the sum of
+    // 1 / e^2 over the rounds: the next reaches the goal with the error `wanted`.
+    const double goal = kSpareShare * target;
+    const double wanted = 1 / std::sqrt(1 / (goal * goal) - 1 / (*now * *now));
+    // Along the slope from b's error, or for a round smaller than b's along the steepest, -1,
+    // since a pattern's gain over independent samples is smallest at few samples (the error of
+    // a stratified 2-sample pixel is far above twice that of 8).
+    const double n = wanted >= *b.error ? b.spp * *b.error / wanted
+                                        : b.spp * std::pow(wanted / *b.error, 1 / slope);
+    const double hi = std::min(std::ceil(n), left);
+    const int count = static_cast<int>(std::max<double>(hi, kMinRound));
     return Prediction{count, predicted_seconds(rounds, count)};
 }
 
 NextRound next_round(const std::vector<ProgressiveRound>& rounds, double target, int max_samples) {
     const ProgressiveRound& last = rounds.back();
-    if ((last.error && *last.error <= target) || last.spp >= max_samples) return {};
+    const int total = total_samples(rounds);
+    const int left = max_samples - total;
+    if ((last.combined && *last.combined <= target) || left < kMinRound) return {};
     // After a round meant as the last that missed, no slope steeper than -1/2: the errors' curves
     // flatten with samples (a pattern's gain over independent samples shrinks), so the slope
-    // that led there was too steep, and a second miss costs a whole round more.
+    // that led there was too steep.
     const std::vector<ProgressiveRound> before(rounds.begin(), rounds.end() - 1);
     const bool missed = !before.empty() && next_round(before, target, max_samples).final;
     const auto p = predict(rounds, target, max_samples, missed ? kIndependentSlope : -1.0);
@@ -117,25 +217,26 @@ NextRound next_round(const std::vector<ProgressiveRound>& rounds, double target,
         next = {std::max((next.spp + kFinalStep - 1) / kFinalStep, kMinPilotGrowth * last.spp),
                 false};
     }
-    // At least a quarter more, or the round is not worth its time; after a near miss a tenth
-    // more, since the estimate's noise alone (some 10 % a round on small images) decides many a
-    // miss, and a quarter more would often overshoot.
-    next.spp = std::max<double>(next.spp, std::ceil((missed ? kRetryGrowth : 1.25) * last.spp));
-    next.spp = static_cast<int>(std::min<double>(next.spp, max_samples));
+    next.spp = std::max<int>(next.spp, static_cast<int>(std::ceil(kMinAddedShare * total)));
+    next.spp = std::clamp(next.spp, kMinRound, left);
     return next;
 }
 
 ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& options,
                                        const ProgressiveGoal& goal) {
     const SettingsGuard guard(scene);
+    const std::uint64_t seed = scene.settings.seed;
     const bool leader = options.mpi == nullptr || options.mpi->leader();
     const auto seconds_left = [&] {
         return *goal.time_limit - std::chrono::duration<double>(Clock::now() - goal.start).count();
     };
     ProgressiveResult out;
+    out.combined = goal.target_error.has_value();
+    std::optional<Combination> combination;
     int spp = std::min(kFirstPilot, goal.max_samples);
     for (std::size_t round = 0; spp > 0; ++round) {
         scene.settings.samples = spp;
+        if (out.combined) scene.settings.seed = round_seed(seed, round);
         // Dropped when the budget runs out before it is done, except the first: without it
         // there would be no image at all.
         std::stop_source stopper;
@@ -157,12 +258,22 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
             out.stopped = options.stop.stop_requested();
             if (out.rounds.empty()) out.job = std::move(job);
         } else {
-            const ProgressiveRound done{spp, job.render.stats.seconds, estimated_error(job.render)};
+            ProgressiveRound done{spp, job.render.stats.seconds, estimated_error(job.render),
+                                  std::nullopt};
+            if (out.combined) {
+                if (!combination)
+                    combination.emplace(job.render.image.width, job.render.image.height);
+                combination->add(job.render, spp);
+                job.render = combination->result(job.render);
+            }
+            done.combined = estimated_error(job.render);
             out.rounds.push_back(done);
             out.job = std::move(job);
-            out.samples = spp;
-            out.error = done.error;
-            out.target_met = goal.target_error && done.error && *done.error <= *goal.target_error;
+            out.samples = total_samples(out.rounds);
+            if (!out.combined) out.samples = spp;
+            out.error = done.combined;
+            out.target_met =
+                goal.target_error && done.combined && *done.combined <= *goal.target_error;
             if (goal.target_error) {
                 const NextRound n = next_round(out.rounds, *goal.target_error, goal.max_samples);
                 next = n.final && goal.pilots_only ? 0 : n.spp;
@@ -173,7 +284,10 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
                 const Line line = time_line(out.rounds);
                 const double fits =
                     std::floor((kTimeShare * seconds_left() - line.setup) / line.per_sample);
-                if (fits < next) next = fits >= 1.25 * spp ? static_cast<int>(fits) : 0;
+                // Combined rounds: whatever fits adds samples. A round replacing the last: only
+                // one a quarter larger is worth its time.
+                const double least = out.combined ? kMinRound : 1.25 * spp;
+                if (fits < next) next = fits >= least ? static_cast<int>(fits) : 0;
             }
         }
         spp = options.mpi ? options.mpi->leaders(next) : next;

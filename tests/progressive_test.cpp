@@ -9,11 +9,16 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <initializer_list>
+#include <optional>
+#include <regex>
 #include <string>
 #include <vector>
 
 #include "drt/converge.h"
 #include "drt/image.h"
+#include "drt/render_job.h"
+#include "drt/scene_loader.h"
 #include "regex_match.h"
 #include "run_drt.h"
 #include "temp_folder.h"
@@ -27,116 +32,165 @@ using test::read_bytes;
 using test::regex_groups;
 using test::run_drt;
 
-TEST(Predict, ExtrapolatesTheLastTwoErrorsAlongTheirSlopeWithATwentiethToSpare) {
-    // Error halving from 8 to 32 samples: slope -1/2, so a quarter of the error needs 16 times
-    // the samples: 32 * 16 * 1.05 = 537.6.
-    const std::vector<ProgressiveRound> rounds{{8, 1.0, 0.08}, {32, 2.5, 0.04}};
+// The combined estimate of rounds weighted by round_weight: 1 / c^2 = sum of 1 / e^2.
+double combined(std::initializer_list<double> errors) {
+    double inverse = 0;
+    for (const double e : errors) inverse += 1 / (e * e);
+    return 1 / std::sqrt(inverse);
+}
+
+// The error one more round must have for rounds combined to `c` to reach 98 % of `target`.
+double wanted(double target, double c) {
+    const double goal = 0.98 * target;
+    return 1 / std::sqrt(1 / (goal * goal) - 1 / (c * c));
+}
+
+TEST(RoundWeight, TheInverseOfTheEstimatedVarianceOrTheCount) {
+    EXPECT_DOUBLE_EQ(round_weight(0.01, 8), 1e4);
+    EXPECT_DOUBLE_EQ(round_weight(0.5, 8), 4.0);
+    EXPECT_DOUBLE_EQ(round_weight(std::nullopt, 8), 8.0);
+    EXPECT_DOUBLE_EQ(round_weight(0.0, 12), 12.0);
+}
+
+TEST(RoundSeed, TheFirstRoundsIsTheScenesAndTheOthersDiffer) {
+    EXPECT_EQ(round_seed(3, 0), 3u);
+    EXPECT_NE(round_seed(3, 1), 3u);
+    EXPECT_NE(round_seed(3, 1), 4u);  // not the next seed, which references often take
+    EXPECT_NE(round_seed(3, 1), round_seed(3, 2));
+    EXPECT_NE(round_seed(3, 1), round_seed(4, 1));
+    EXPECT_EQ(round_seed(3, 2), round_seed(3, 2));
+}
+
+TEST(Predict, FromOneRoundAlongTheSteepestSlope) {
+    // One pilot at 0.04 against a target of 0.01: one more round must have the error
+    // 1 / sqrt(1 / 0.0098^2 - 1 / 0.04^2) = 0.010108, which along -1 is 8 * 0.04 / 0.010108 =
+    // 31.66 samples.
+    const std::vector<ProgressiveRound> one{{8, 1.0, 0.04, 0.04}};
+    const auto p = predict(one, 0.01, 65536);
+    ASSERT_TRUE(p);
+    EXPECT_NEAR(8 * 0.04 / wanted(0.01, 0.04), 31.66, 0.01);
+    EXPECT_EQ(p->spp, 32);
+    EXPECT_DOUBLE_EQ(p->seconds, 32 / 8.0);
+    // Along -1/2 instead: 8 * (0.04 / 0.010108)^2 = 125.3.
+    EXPECT_EQ(predict(one, 0.01, 65536, -0.5)->spp, 126);
+    // Met already, or no samples left: nothing more; capped at what is left of the maximum.
+    EXPECT_EQ(predict(one, 0.05, 65536)->spp, 0);
+    EXPECT_EQ(predict(one, 0.01, 9)->spp, 0);
+    EXPECT_EQ(predict(one, 0.01, 20)->spp, 12);
+    // Rounds without an estimate are skipped.
+    EXPECT_EQ(predict({{4, 1, std::nullopt, std::nullopt}, {8, 1, 0.04, 0.04}}, 0.01, 65536)->spp,
+              32);
+}
+
+TEST(Predict, TakesTheSlopeOverAtLeastThreefoldTheSamplesHeldBetweenMinusOneAndAQuarter) {
+    // 8 to 32 samples, error 0.08 to 0.04: slope -1/2, and the two combine to 0.0358. The next
+    // round needs the error wanted(0.01, 0.0358) = 0.0102: 32 * (0.04 / 0.0102)^2 = 493.1.
+    const double c = combined({0.08, 0.04});
+    EXPECT_NEAR(c, 0.0358, 1e-4);
+    const std::vector<ProgressiveRound> rounds{{8, 1.0, 0.08, std::nullopt}, {32, 2.5, 0.04, c}};
     const auto p = predict(rounds, 0.01, 65536);
     ASSERT_TRUE(p);
-    EXPECT_EQ(p->spp, 538);
+    EXPECT_NEAR(32 * std::pow(0.04 / wanted(0.01, c), 2), 493.1, 0.1);
+    EXPECT_EQ(p->spp, 494);
     // Time: 0.5 s of set-up and 1.5 s / 24 samples = 0.0625 s a sample.
-    EXPECT_DOUBLE_EQ(p->seconds, 0.5 + 0.0625 * 538);
-    // Met already: the last count.
-    EXPECT_EQ(predict(rounds, 0.05, 65536)->spp, 32);
-    // Capped at the maximum.
-    EXPECT_EQ(predict(rounds, 0.01, 100)->spp, 100);
+    EXPECT_DOUBLE_EQ(p->seconds, 0.5 + 0.0625 * 494);
+    // A flat pair (slope 0) is taken as -1/4: 32 * (0.08 / wanted(0.02, 0.0566))^4 = 6877.04.
+    const double flat = combined({0.08, 0.08});
+    EXPECT_EQ(predict({{8, 1, 0.08, std::nullopt}, {32, 2, 0.08, flat}}, 0.02, 65536)->spp, 6878);
+    // A slope of -2 (luck) is taken as -1: 32 * 0.01 / wanted(0.005, 0.00998) = 56.9; held at
+    // -1/2, 32 * (0.01 / wanted)^2 = 101.2.
+    const std::vector<ProgressiveRound> steep{{8, 1, 0.16, std::nullopt},
+                                              {32, 2, 0.01, combined({0.16, 0.01})}};
+    EXPECT_EQ(predict(steep, 0.005, 65536)->spp, 57);
+    EXPECT_EQ(predict(steep, 0.005, 65536, -0.5)->spp, 102);
+    // 100 to 120 samples is too narrow a span: the steepest slope from the larger round, as from
+    // one round.
+    const std::vector<ProgressiveRound> narrow{{100, 1, 0.2, std::nullopt}, {120, 1, 0.011, 0.01}};
+    EXPECT_EQ(predict(narrow, 0.0099, 65536)->spp,
+              static_cast<int>(std::ceil(120 * 0.011 / wanted(0.0099, 0.01))));
 }
 
-TEST(Predict, HoldsTheSlopeBetweenMinusOneAndMinusAQuarter) {
-    // A flat pair of pilots (slope 0) is taken as -1/4: half the error needs 16 times the samples.
-    const std::vector<ProgressiveRound> flat{{8, 1, 0.08}, {32, 2, 0.08}};
-    EXPECT_EQ(predict(flat, 0.04, 65536)->spp, static_cast<int>(std::ceil(32 * 16 * 1.05)));
-    // A slope of -2 (luck) is taken as -1: half the error needs twice the samples.
-    const std::vector<ProgressiveRound> steep{{8, 1, 0.16}, {32, 2, 0.01}};
-    EXPECT_EQ(predict(steep, 0.005, 65536)->spp, static_cast<int>(std::ceil(32 * 2 * 1.05)));
-    // Held at -1/2 instead: a quarter of the error needs 16 times the samples.
-    EXPECT_EQ(predict(steep, 0.0025, 65536, -0.5)->spp,
-              static_cast<int>(std::ceil(32 * 16 * 1.05)));
-}
-
-TEST(Predict, FromOneRoundTakesTheSlopeOfIndependentSamples) {
-    // Slope -1/2: an eighth of the error needs 64 times the samples: 8 * 64 * 1.05 = 537.6.
-    const auto p = predict({{8, 1.0, 0.08}}, 0.01, 65536);
-    ASSERT_TRUE(p);
-    EXPECT_EQ(p->spp, 538);
-    EXPECT_DOUBLE_EQ(p->seconds, 538 / 8.0);
-    // Rounds without an estimate are skipped: the slope is still the assumed one.
-    EXPECT_EQ(predict({{4, 1, std::nullopt}, {8, 1, 0.08}}, 0.01, 65536)->spp, 538);
-}
-
-TEST(Predict, TakesTheSlopeOverAtLeastThreefoldTheSamples) {
-    // 100 to 120 samples: too narrow a span for a slope, so -1/2 from the last round:
-    // 120 * 1.21 * 1.05 = 152.46.
-    EXPECT_EQ(predict({{100, 1, 0.2}, {120, 1, 0.011}}, 0.01, 65536)->spp, 153);
-    // With a round a third as large before them, the slope from it: 40 to 120 samples, error
-    // 0.022 to 0.011, slope -0.63; 120 * 1.1^(1 / 0.63) * 1.05 = 146.5.
-    const std::vector<ProgressiveRound> rounds{{40, 1, 0.022}, {100, 1, 0.2}, {120, 1, 0.011}};
-    EXPECT_EQ(predict(rounds, 0.01, 65536)->spp, 147);
+TEST(Predict, ARoundSmallerThanTheLargestAlongMinusOne) {
+    // Just missed at 40 samples: one more round needs only the error wanted(0.01, 0.0102) =
+    // 0.0353, above 0.0102, so fewer samples than 40, along -1: 40 * 0.0102 / 0.0353 = 11.5.
+    EXPECT_EQ(predict({{40, 1, 0.0102, 0.0102}}, 0.01, 65536)->spp, 12);
+    // The largest round is extrapolated from, not the latest.
+    const std::vector<ProgressiveRound> rounds{
+        {8, 1, 0.03, std::nullopt}, {40, 1, 0.0102, std::nullopt}, {12, 1, 0.05, 0.0101}};
+    EXPECT_EQ(predict(rounds, 0.01, 65536)->spp,
+              static_cast<int>(std::ceil(40 * 0.0102 / wanted(0.01, 0.0101))));
 }
 
 TEST(Predict, NeedsARoundWithAPositiveEstimate) {
-    EXPECT_FALSE(predict({{8, 1, std::nullopt}}, 0.01, 65536));
-    EXPECT_FALSE(predict({{8, 1, 0.0}, {32, 2, 0.0}}, 0.01, 65536));
+    EXPECT_FALSE(predict({{8, 1, std::nullopt, std::nullopt}}, 0.01, 65536));
+    EXPECT_FALSE(predict({{8, 1, 0.0, 0.0}, {32, 2, 0.0, 0.0}}, 0.01, 65536));
+    // Nor without the combined estimate.
+    EXPECT_FALSE(predict({{8, 1, 0.04, std::nullopt}}, 0.01, 65536));
 }
 
 TEST(NextRound, ThePredictedCountWhenWithinTheFinalStep) {
-    // 32 * 4 * 1.05 = 134.4: at most 12 times 32, so the round the target is predicted to need.
-    const std::vector<ProgressiveRound> rounds{{8, 1.0, 0.08}, {32, 2.5, 0.04}};
-    const NextRound n = next_round(rounds, 0.02, 65536);
-    EXPECT_EQ(n.spp, 135);
+    const std::vector<ProgressiveRound> one{{8, 1.0, 0.04, 0.04}};
+    const NextRound n = next_round(one, 0.01, 65536);
+    EXPECT_EQ(n.spp, 32);
     EXPECT_TRUE(n.final);
-    // Capped at the maximum, and nothing once it is reached or the target is met.
-    EXPECT_EQ(next_round(rounds, 0.02, 100).spp, 100);
-    EXPECT_EQ(next_round(rounds, 0.02, 32).spp, 0);
-    EXPECT_EQ(next_round(rounds, 0.04, 65536).spp, 0);
+    // Capped at what is left of the maximum, and nothing once fewer than 2 samples are left or
+    // the target is met.
+    EXPECT_EQ(next_round(one, 0.01, 20).spp, 12);
+    EXPECT_EQ(next_round(one, 0.01, 9).spp, 0);
+    EXPECT_EQ(next_round(one, 0.04, 65536).spp, 0);
 }
 
 TEST(NextRound, APilotATwelfthOfAPredictionFurtherAway) {
-    // 32 * 256 * 1.05 = 8601.6 -> 8602, more than 12 times 32: a pilot of 8602 / 12 = 717.
-    const std::vector<ProgressiveRound> rounds{{8, 1.0, 0.08}, {32, 2.5, 0.04}};
-    const NextRound n = next_round(rounds, 0.0025, 65536);
-    EXPECT_EQ(n.spp, 717);
+    // 8 * 0.08 / wanted(0.001, 0.08) = 653.0, more than 12 times 8: a pilot of 55.
+    EXPECT_NEAR(8 * 0.08 / wanted(0.001, 0.08), 653.0, 0.1);
+    const NextRound n = next_round({{8, 1.0, 0.08, 0.08}}, 0.001, 65536);
+    EXPECT_EQ(n.spp, 55);
     EXPECT_FALSE(n.final);
-    // From the first pilot alone (slope -1/2): 8 * 441 * 1.05 = 3704.4 -> a pilot of 309.
-    EXPECT_EQ(next_round({{8, 1.0, 0.21}}, 0.01, 65536).spp, 309);
-    // A twelfth that is less than 4 times the last round is raised to 4 times: 32 * 16 * 1.05 =
-    // 537.6 -> 538, a twelfth 45, raised to 128.
-    EXPECT_EQ(next_round(rounds, 0.01, 65536).spp, 128);
-}
-
-TEST(NextRound, AtLeastAQuarterMoreAndFourTimesWithoutAnEstimate) {
-    // Just over the target: 100 * 1.05 would be 106, raised to 125.
-    EXPECT_EQ(next_round({{100, 2, 0.0100001}}, 0.01, 65536).spp, 125);
-    const NextRound blind = next_round({{8, 1, std::nullopt}}, 0.01, 65536);
+    // A twelfth that is less than 4 times the last round is raised to 4 times: 8 * 0.08 /
+    // wanted(0.004, 0.08) = 163.3, a twelfth 14, raised to 32.
+    EXPECT_EQ(next_round({{8, 1.0, 0.08, 0.08}}, 0.004, 65536).spp, 32);
+    // Without an estimate, a pilot 4 times the last.
+    const NextRound blind = next_round({{8, 1, std::nullopt, std::nullopt}}, 0.01, 65536);
     EXPECT_EQ(blind.spp, 32);
     EXPECT_FALSE(blind.final);
 }
 
+TEST(NextRound, AtLeastATenthOfTheSamplesSoFarAndTwo) {
+    // Eight rounds of 25 samples at 0.02829 combine to 0.010002, just over 0.01: one more round of
+    // 25 * 0.02829 / wanted(0.01, 0.010002) = 14.4 samples would do, raised to a tenth of 200.
+    const std::vector<ProgressiveRound> eight(
+        8, {25, 1, 0.02829,
+            combined({0.02829, 0.02829, 0.02829, 0.02829, 0.02829, 0.02829, 0.02829, 0.02829})});
+    EXPECT_EQ(predict(eight, 0.01, 65536)->spp, 15);
+    EXPECT_EQ(next_round(eight, 0.01, 65536).spp, 20);
+    // At 8 samples a tenth is 1: raised to 2, the fewest with an estimate.
+    EXPECT_EQ(next_round({{8, 2, 0.0100001, 0.0100001}}, 0.01, 65536).spp, 2);
+}
+
 TEST(NextRound, AfterAFinalRoundThatMissedASlopeNoSteeperThanMinusAHalf) {
-    // The pilots 8 and 32 measure -0.87, which predicts 120 spp as the final round. It misses:
-    // from 32 to 120 the slope was -0.80, but the next round goes along -1/2, 120 * 1.04^2 *
-    // 1.05 = 136.3 (-0.80 and a quarter more, as before a miss, would have been 150).
-    const std::vector<ProgressiveRound> pilots{{8, 1, 0.1}, {32, 1, 0.03}};
-    const NextRound final = next_round(pilots, 0.01, 65536);
-    EXPECT_EQ(final.spp, 120);
-    EXPECT_TRUE(final.final);
-    std::vector<ProgressiveRound> missed = pilots;
-    missed.push_back({120, 1, 0.0104});
-    EXPECT_EQ(next_round(missed, 0.01, 65536).spp, 137);
-    // A near miss: at least a tenth more (51 * 1.1 = 56.1), not a quarter (64).
-    const NextRound near = next_round({{40, 1, 0.011}}, 0.01, 65536);
-    EXPECT_EQ(near.spp, 51);
-    EXPECT_TRUE(near.final);
-    EXPECT_EQ(next_round({{40, 1, 0.011}, {51, 1, 0.0101}}, 0.01, 65536).spp, 57);
-    // A pilot that is not the last round is no miss: the quarter still holds.
-    EXPECT_EQ(next_round({{8, 1, 0.2}, {32, 1, 0.0101}}, 0.01, 65536).spp, 40);
+    // From one pilot, along -1: 32 samples, meant as the last round. It misses (its own error
+    // 0.016, the two combined 0.0149), and 8 to 32 samples measure the slope -0.66; the next
+    // round goes along -1/2 from the 32-sample round instead: 32 * (0.016 / 0.0130)^2 = 48.2.
+    const std::vector<ProgressiveRound> pilot{{8, 1, 0.04, 0.04}};
+    ASSERT_TRUE(next_round(pilot, 0.01, 65536).final);
+    std::vector<ProgressiveRound> missed = pilot;
+    missed.push_back({32, 1, 0.016, combined({0.04, 0.016})});
+    EXPECT_EQ(next_round(missed, 0.01, 65536).spp, 49);
+    // A pilot that is not meant as the last round is no miss: the measured slope holds, -0.71
+    // from 8 to 32 samples: 32 * (wanted(0.006, 0.0281) / 0.03)^(1 / -0.71) = 310.3.
+    const std::vector<ProgressiveRound> far{{8, 1, 0.08, 0.08}};
+    ASSERT_FALSE(next_round(far, 0.006, 65536).final);
+    const std::vector<ProgressiveRound> pilots{{8, 1, 0.08, 0.08},
+                                               {32, 1, 0.03, combined({0.08, 0.03})}};
+    EXPECT_EQ(next_round(pilots, 0.006, 65536).spp, 311);
 }
 
 TEST(PredictedSeconds, ALineThroughTheLastTwoRoundsOrProportionalToOne) {
-    EXPECT_DOUBLE_EQ(predicted_seconds({{10, 2.0, {}}}, 100), 20.0);
-    EXPECT_DOUBLE_EQ(predicted_seconds({{10, 2.0, {}}, {20, 3.0, {}}}, 100), 1.0 + 0.1 * 100);
+    EXPECT_DOUBLE_EQ(predicted_seconds({{10, 2.0, {}, {}}}, 100), 20.0);
+    EXPECT_DOUBLE_EQ(predicted_seconds({{10, 2.0, {}, {}}, {20, 3.0, {}, {}}}, 100),
+                     1.0 + 0.1 * 100);
     // Times that fall with samples (noise) never predict a free sample: the last round's rate.
-    EXPECT_DOUBLE_EQ(predicted_seconds({{10, 3.0, {}}, {20, 2.0, {}}}, 100), 10.0);
+    EXPECT_DOUBLE_EQ(predicted_seconds({{10, 3.0, {}, {}}, {20, 2.0, {}, {}}}, 100), 10.0);
 }
 
 // ---- the command line --------------------------------------------------------------------------
@@ -156,6 +210,17 @@ constexpr const char* kScene = R"(<?xml version="1.0"?>
   <Sphere Px="0" Py="1" Pz="0" Radius="1" Material="Grey"/>
 </Scene>
 )";
+
+// Group 1 of every match of `pattern` in `text`.
+std::vector<std::string> all_groups(const std::string& text, const std::string& pattern) {
+    std::vector<std::string> out;
+    const std::regex re(pattern);
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), re); it != std::sregex_iterator();
+         ++it) {
+        out.push_back((*it)[1].str());
+    }
+    return out;
+}
 
 class GoalCli : public test::TempFolderTest {
   protected:
@@ -198,19 +263,71 @@ TEST_F(GoalCli, BadGoalsExitTwoWithTheReasonAndWriteNothing) {
     EXPECT_FALSE(fs::exists(dir_ / "c.ckpt"));
 }
 
-TEST_F(GoalCli, SppIsTheMaximumAndTheImageIsThePlainRenderOfTheCountReached) {
+TEST_F(GoalCli, SppIsTheMaximumOfAllRoundsTogether) {
     // An error no 40 samples reach: the rounds stop at the maximum (the pilot after the first
-    // would be far more).
+    // would be far more, and is cut to the 32 samples left).
     const Outcome r = run({"scene.xml", "--target-error", "1e-9", "--spp", "40", "-o", "goal.pfm",
                            "--stats", "s.json"});
     ASSERT_EQ(r.status, 0) << r.err;
-    EXPECT_EQ(reached(r.err), 40) << r.err;
-    EXPECT_NE(r.err.find("after rounds of 8, 40 spp"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(": 40 spp after rounds of 8, 32 spp"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("(target 1e-09 not met)"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("the same command renders the same image (bit-identical) every run"),
+              std::string::npos)
+        << r.err;
     EXPECT_NE(bytes("s.json").find("\"samples_per_pixel\": 40"), std::string::npos);
     EXPECT_NE(bytes("s.json").find("\"target_met\": false"), std::string::npos);
-    ASSERT_EQ(run({"scene.xml", "--spp", "40", "-o", "plain.pfm", "-q"}).status, 0);
-    EXPECT_EQ(bytes("goal.pfm"), bytes("plain.pfm"));
+    EXPECT_NE(bytes("s.json").find("\"combined\": true"), std::string::npos);
+    // Each round's seed, to render it alone.
+    EXPECT_NE(bytes("s.json").find("{\"spp\": 8, \"seed\": \"3\", "), std::string::npos);
+    EXPECT_NE(bytes("s.json").find("{\"spp\": 32, \"seed\": \"" + std::to_string(round_seed(3, 1)) +
+                                   "\", "),
+              std::string::npos)
+        << bytes("s.json");
+}
+
+TEST(RenderProgressively, TheImageIsTheRoundsWeightedByTheirInverseEstimatedVariance) {
+    LoadedScene loaded = load_scene_from_string(kScene, "scene.xml");
+    Scene& scene = loaded.scene;
+    ProgressiveGoal goal;
+    goal.target_error = 1e-9;
+    goal.max_samples = 40;
+    RenderJobOptions options;
+    options.threads = 2;
+    const ProgressiveResult p = render_progressively(scene, options, goal);
+    ASSERT_EQ(p.rounds.size(), 2u);
+    EXPECT_EQ(p.rounds[0].spp, 8);
+    EXPECT_EQ(p.rounds[1].spp, 32);
+    EXPECT_EQ(p.samples, 40);
+    EXPECT_TRUE(p.combined);
+    EXPECT_EQ(scene.settings.seed, 3u);  // restored
+    // Each round alone: the plain render of its count and seed.
+    std::vector<RenderResult> alone;
+    for (std::size_t i = 0; i < 2; ++i) {
+        scene.settings.samples = p.rounds[i].spp;
+        scene.settings.seed = round_seed(3, i);
+        alone.push_back(run_render_job(scene, options).render);
+        ASSERT_TRUE(alone.back().stats.error.rmse);
+        EXPECT_EQ(p.rounds[i].error, alone.back().stats.error.rmse);
+    }
+    const double w0 = round_weight(alone[0].stats.error.rmse, 8);
+    const double w1 = round_weight(alone[1].stats.error.rmse, 32);
+    // The 32-sample round weighs more than 4 times the 8-sample one: its stratified error is
+    // more than halved.
+    EXPECT_GT(w1, 4 * w0);
+    const Image& image = p.job.render.image;
+    ASSERT_EQ(image.rgb.size(), alone[0].image.rgb.size());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < image.rgb.size(); ++i) {
+        const double mean = (w0 * alone[0].image.rgb[i] + w1 * alone[1].image.rgb[i]) / (w0 + w1);
+        differ += image.rgb[i] != static_cast<float>(mean);
+    }
+    EXPECT_EQ(differ, 0u);
+    // The combined estimate: the variance of that mean, 1 / (w0 + w1).
+    ASSERT_TRUE(p.error);
+    EXPECT_NEAR(*p.error, 1 / std::sqrt(w0 + w1), 1e-5 / std::sqrt(w0 + w1));
+    EXPECT_EQ(p.job.render.stats.samples, alone[0].stats.samples + alone[1].stats.samples);
+    EXPECT_EQ(p.job.render.stats.rays.total(),
+              alone[0].stats.rays.total() + alone[1].stats.rays.total());
 }
 
 TEST_F(GoalCli, TimeLimitStopsByTheLimitWithThePlainRenderOfTheCountReached) {
@@ -279,22 +396,28 @@ TEST_F(GoalCli, InfoPredictsTheSamplesAndTimeFromPilots) {
         r.out,
         "\npilots: 8 spp [0-9.]+ s, estimated rmse [0-9.e-]+;( [0-9]+ spp [0-9.]+ s, estimated "
         "rmse [0-9.e-]+;)*\npredicted for --target-error 0.005: ([0-9]+) spp, [0-9.]+ s on this "
-        "machine \\(--spp ([0-9]+) alone: [0-9.]+ s\\)\n$");
-    ASSERT_EQ(groups.size(), 4u) << r.out;
-    EXPECT_EQ(groups[2], groups[3]) << r.out;
-    // The render to the target takes the same pilots (its rounds' errors are the same bits) and
-    // then the predicted count, and more only where that count's estimate misses the target (here
-    // it lands just above it, 0.00514, and one more round follows).
+        "machine \\(rounds of (8(, [0-9]+)*) spp\\)\n$");
+    ASSERT_EQ(groups.size(), 5u) << r.out;
+    // The predicted samples are the rounds' together.
+    int predicted = 0;
+    for (const auto& count : all_groups(groups[3], "([0-9]+)")) predicted += std::stoi(count);
+    EXPECT_EQ(std::to_string(predicted), groups[2]) << r.out;
+    // The render to the target takes the same rounds first (their errors are the same bits) and
+    // more only where the predicted final round misses the target.
     ASSERT_EQ(
         run({"scene.xml", "--target-error", "0.005", "-o", "g.pfm", "--stats", "s.json", "-q"})
             .status,
         0);
     const std::string stats = bytes("s.json");
     EXPECT_NE(stats.find("\"target_met\": true"), std::string::npos) << stats;
-    EXPECT_NE(stats.find("{\"spp\": " + groups[2] + ", \"seconds\""), std::string::npos) << stats;
+    std::string rounds;
+    for (const auto& count : all_groups(stats, "\\{\"spp\": ([0-9]+),")) {
+        rounds += (rounds.empty() ? "" : ", ") + count;
+    }
+    EXPECT_EQ(rounds.substr(0, groups[3].size()), groups[3]) << stats;
     const auto spp = regex_groups(stats, "\"samples_per_pixel\": ([0-9]+),");
     ASSERT_EQ(spp.size(), 2u) << stats;
-    EXPECT_GE(std::stoi(spp[1]), std::stoi(groups[2])) << stats;
+    EXPECT_GE(std::stoi(spp[1]), predicted) << stats;
     const Outcome bad = run({"info", "scene.xml", "--target-error", "0"});
     EXPECT_EQ(bad.status, 2);
     EXPECT_EQ(bad.err,

@@ -52,7 +52,7 @@ json() { sed -n "s/.*\"$1\": \\([0-9.e+-]*\\).*/\\1/p" "$2" | head -1; }
 median() { tr ' ' '\n' | sort -g | awk '{v[NR] = $1} END {print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
 
 csv=$work/goal-study.csv
-echo "scene,target,predicted_spp,predicted_s,goal_spp,goal_rounds,goal_s,goal_render_s,goal_estimated,goal_true,fixed_spp,fixed_s,fixed_render_s,fixed_true" >"$csv"
+echo "scene,target,predicted_spp,predicted_s,goal_spp,goal_rounds,goal_s,goal_render_s,goal_estimated,goal_true,fixed_spp,fixed_s,fixed_render_s,fixed_true,load" >"$csv"
 for name in $scenes; do
     scene=$root/scenes/thesis/$name.xml
     ref=$work/$name-$scale-ref.pfm
@@ -97,15 +97,19 @@ for name in $scenes; do
         rounds=$(grep -o '"spp": [0-9]*' "$tmp/goal.json" | sed 's/"spp": //' | paste -sd' ')
         estimated=$(json estimated_rmse "$tmp/goal.json")
         goal_true=$("$drt" compare "$tmp/goal.pfm" "$ref" | sed 's/rmse=\([^ ]*\).*/\1/')
-        echo "$name,$target,$predicted,$goal_spp,$rounds,$goal_s,$(json seconds "$tmp/goal.json"),$estimated,$goal_true,$fixed,$fixed_s,$(json seconds "$tmp/fixed.json"),$(rmse_at "$fixed")" >>"$csv"
+        echo "$name,$target,$predicted,$goal_spp,$rounds,$goal_s,$(json seconds "$tmp/goal.json"),$estimated,$goal_true,$fixed,$fixed_s,$(json seconds "$tmp/fixed.json"),$(rmse_at "$fixed"),$(cut -d' ' -f1 /proc/loadavg)" >>"$csv"
         log "$name E=$target: goal $goal_s s ($rounds spp), fixed $fixed_s s"
     done
 done
 
-echo "| scene | E | predicted spp | predicted s | goal rounds (spp) | goal s | goal estimated RMSE | goal true RMSE | true / E | cheapest fixed spp (true RMSE ≤ E) | its s | goal s / fixed s |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
-tail -n +2 "$csv" | while IFS=, read -r name target pspp ps gspp rounds gs grs gest gtrue fspp fs frs ftrue; do
-    printf '| %s | %s | %s | %.2f | %s | %.2f | %.5f | %.5f | %.2f | %s | %.2f | %.2f |\n' \
+# "goal samples / fixed": every round's samples against the fixed count's (free of the machine's
+# noise); "load" the 1-minute load average when the case was timed.
+echo "| scene | E | predicted spp | predicted s | goal rounds (spp) | goal s | goal estimated RMSE | goal true RMSE | true / E | cheapest fixed spp (true RMSE ≤ E) | its s | goal samples / fixed | goal s / fixed s | load |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+tail -n +2 "$csv" | while IFS=, read -r name target pspp ps gspp rounds gs grs gest gtrue fspp fs frs ftrue load; do
+    samples=$(echo "${rounds// /+}" | bc)
+    printf '| %s | %s | %s | %.2f | %s | %.2f | %.5f | %.5f | %.2f | %s | %.2f | %.2f | %.2f | %s |\n' \
         "$name" "$target" "$pspp" "$ps" "${rounds// /, }" "$gs" "$gest" "$gtrue" \
-        "$(echo "$gtrue / $target" | bc -l)" "$fspp" "$fs" "$(echo "$gs / $fs" | bc -l)"
+        "$(echo "$gtrue / $target" | bc -l)" "$fspp" "$fs" "$(echo "$samples / $fspp" | bc -l)" \
+        "$(echo "$gs / $fs" | bc -l)" "$load"
 done

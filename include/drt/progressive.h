@@ -1,14 +1,25 @@
 // Rendering to a goal instead of a sample count: until the image's estimated error reaches a
-// target (--target-error), or for as long as a time budget allows (--time-limit). Each round is
-// a complete render at one sample count, so the image kept is always bit-identical to the plain
-// render `--spp N` of the count N it reached, for every sampler (a stratified pattern of N
-// samples does not extend one of fewer, so rounds do not continue one another's samples). The
-// counts are chosen on the leader from the rounds' estimated errors and times and shared with
-// every process, so a goal of error alone gives the same bits for any --threads and any number
-// of processes; a time budget stops where the machine's speed lets it.
+// target (--target-error), or for as long as a time budget allows (--time-limit).
+//
+// To a target error, the rounds add up: each round is a complete render of the whole image with
+// its own seed (round_seed), an independent stratified or Sobol pattern of its count, and the
+// image is the weighted mean of the rounds' images (round_weight), so no round's samples are
+// thrown away. Independent rounds make the variance of that mean the sum of the rounds'
+// variances times their weights squared, which is what the combined estimate states, pixel by
+// pixel. The counts are chosen on the leader from the rounds' estimated errors and shared with
+// every process, so the same command gives the same bits for any --threads and any number of
+// processes. The first round is the plain render `--spp 8`; the image as a whole is no plain
+// render's (a stratified pattern of N samples does not extend one of fewer).
+//
+// To a time limit alone, each round is a complete render at one sample count that replaces the
+// last, so the image kept is bit-identical to the plain render `--spp N` of the count N it
+// reached and can be rendered again without the clock; where the rounds stop depends on the
+// machine's speed.
 #pragma once
 
 #include <chrono>
+#include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -29,8 +40,26 @@ struct ProgressiveGoal {
 struct ProgressiveRound {
     int spp = 0;
     double seconds = 0;           // its wall-clock time
-    std::optional<double> error;  // its estimated RMSE; absent where it cannot be estimated
+    std::optional<double> error;  // its own estimated RMSE; absent where it cannot be estimated
+    // The estimated RMSE of the image kept after it: of the rounds so far combined (a target
+    // error), or its own (a time limit alone).
+    std::optional<double> combined;
 };
+
+// The seed of round `round` (from 0) of a render to a target error: the scene's for the first, so
+// that the pilot is the plain render of its count, and a hash of it for the others, whose
+// patterns are then independent of the first's and of every plain render's with a nearby seed.
+std::uint64_t round_seed(std::uint64_t seed, std::size_t round);
+
+// A round's weight in the combined image: the inverse of its estimated variance, 1 / error^2,
+// which gives the mean with the least variance; a stratified or Sobol round's samples are worth
+// more the more of them it has (their error falls faster than 1 / sqrt(n)), so weighting by count
+// would undervalue the largest round. Its count where it has no positive estimate (where all
+// rounds have none, the image is still the mean of their samples).
+double round_weight(const std::optional<double>& error, int spp);
+
+// The samples per pixel of all rounds together.
+int total_samples(const std::vector<ProgressiveRound>& rounds);
 
 // Samples per pixel and time a render needs to reach an error, extrapolated from rounds.
 struct Prediction {
@@ -38,13 +67,18 @@ struct Prediction {
     double seconds = 0;
 };
 
-// The count at which the error of the last round, extrapolated along the log-log slope from the
-// latest round with an estimate and at most a third of its count (held between `steepest` and
-// -1/4: rounds are noisy), falls to `target`, with 5 % to spare, at most `max_samples`; the time
-// from a line through the rounds' times. Without such a round the slope is taken as -1/2, that
-// of independent samples, which no sampler drt has falls short of (stratified and Sobol patterns
-// converge faster), so the count errs on the large side. Absent when no round has a positive
-// estimate.
+// The count of one more round at which the rounds combined reach `target` (with kSpareShare of
+// it to spare), at most `max_samples` in all rounds together (0 when none is left or `target` is
+// met), and its time from a line through the rounds' times. A round's own error is extrapolated
+// from the latest round with an estimate along the log-log slope from the latest earlier one at
+// most a third of its count (held between `steepest` and -1/4: rounds are noisy); without such a
+// round the slope is taken as -1/2, that of independent samples, which no sampler drt has falls
+// short of (stratified and Sobol patterns converge faster), so the count errs on the large side.
+// A round smaller than that one's is extrapolated along -1 instead: a pattern's gain over
+// independent samples is smallest at few samples. With round_weight's weights the combined error
+// c' of one more round of error e is 1 / c'^2 = 1 / c^2 + 1 / e^2, c the rounds' combined
+// estimate so far. At least 2 samples. Absent when no round has a positive estimate or the last
+// has no combined one.
 std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, double target,
                                   int max_samples, double steepest = -1.0);
 
@@ -52,13 +86,14 @@ std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, d
 // the last two rounds' times; from the last round alone when there is one.
 double predicted_seconds(const std::vector<ProgressiveRound>& rounds, int spp);
 
-// The count of the round after `rounds` on the way to `target` (at most `max_samples`, 0 when
-// the target is met or max_samples reached): the predicted count itself when it is at most
-// kFinalStep times the last round's (`final`), otherwise a pilot a kFinalStep-th of it (at least 4
-// times the last round), whose error against the last round's measures the slope over a wide span,
-// so that the next prediction extrapolates only kFinalStep-fold and lands on the count in one step.
-// After a final round that missed (the estimate's noise decides many), the prediction along a
-// slope no steeper than -1/2, and at least a tenth more samples (otherwise a quarter).
+// The count of the round after `rounds` on the way to `target` (with all rounds at most
+// `max_samples`; 0 when the combined estimate meets the target or fewer than 2 samples are left):
+// the predicted count itself when it is at most kFinalStep times the last round's (`final`),
+// otherwise a pilot a kFinalStep-th of it (at least 4 times the last round), whose error against
+// the last round's measures the slope over a wide span, so that the next prediction extrapolates
+// only kFinalStep-fold. After a final round that missed (the estimate's noise decides many), the
+// prediction along a slope no steeper than -1/2. A round adds at least a tenth of the samples so
+// far, and at least 2 (a round of 1 sample has no estimate).
 struct NextRound {
     int spp = 0;
     bool final = false;
@@ -66,8 +101,9 @@ struct NextRound {
 NextRound next_round(const std::vector<ProgressiveRound>& rounds, double target, int max_samples);
 
 struct ProgressiveResult {
-    RenderJobResult job;          // the image kept: the last complete round's
-    int samples = 0;              // its samples per pixel: `--spp samples` renders the same bits
+    RenderJobResult job;    // the image kept: the rounds combined, or a time limit's last round
+    int samples = 0;        // its samples per pixel, all rounds kept together
+    bool combined = false;  // a target error: the rounds are combined
     std::optional<double> error;  // its estimated RMSE
     std::vector<ProgressiveRound> rounds;
     bool target_met = false;
@@ -79,13 +115,17 @@ struct ProgressiveResult {
 inline constexpr int kFirstPilot = 8;
 // A final round at most this many times the last round's count; see next_round.
 inline constexpr int kFinalStep = 12;
+// A round meant as the last aims at this share of the target error: a miss costs only a small
+// round more, since the rounds add up.
+inline constexpr double kSpareShare = 0.98;
 
 // Collective under MPI. A round at kFirstPilot, then for a target error the rounds next_round
-// sizes, for a time budget the largest predicted to fit (with a tenth to spare), until the goal
-// is met, the budget is spent or the next round would pass max_samples; with goal.pilots_only,
-// a target error stops before its final round (what drt info --target-error renders). A round still
-// running when the budget runs out is stopped and dropped. options.checkpoint must be absent. The
-// scene's sample count is changed during the rounds and restored afterwards.
+// sizes (combined; also under a time limit, which may end them early), for a time budget alone
+// the largest predicted to fit (with a tenth to spare), until the goal is met, the budget is spent
+// or max_samples reached; with goal.pilots_only, a target error stops before its final round
+// (what drt info --target-error renders). A round still running when the budget runs out is
+// stopped and dropped. options.checkpoint and options.adaptive must be absent. The scene's sample
+// count and seed are changed during the rounds and restored afterwards.
 ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& options,
                                        const ProgressiveGoal& goal);
 
