@@ -442,12 +442,12 @@ std::string goal_summary(const std::string& name, const ProgressiveResult& p, co
     if (!p.combined) {
         line << "\ndrt: " << name << ": --spp " << p.samples
              << " renders the same image (bit-identical) without a goal\n";
-    } else if (goal.time_limit) {
-        line << "\ndrt: " << name << ": the rounds' images combined, weighted by their counts; "
-             << "the same command renders the same image where it completes the same rounds\n";
     } else {
-        line << "\ndrt: " << name << ": the rounds' images combined, weighted by their counts; "
-             << "the same command renders the same image (bit-identical) every run\n";
+        line << "\ndrt: " << name
+             << ": the rounds' images combined (weighted by 1 / estimated variance); the same "
+                "command renders the same image "
+             << (goal.time_limit ? "where it completes the same rounds\n"
+                                 : "(bit-identical) every run\n");
     }
     return line.str();
 }
@@ -979,6 +979,10 @@ struct GoalForecast {
     std::vector<ProgressiveRound> pilots;
     int final_round = 0;              // the final round's count; 0 when the pilots reach it
     std::optional<Prediction> total;  // all rounds together
+    // All rounds together if the final round's error falls only as N^-1/2 (that of independent
+    // samples): the final round is sized on the short side, so where it falls short this is the
+    // better guess.
+    std::optional<Prediction> slow;
 };
 
 GoalForecast forecast(Scene& scene, double target, int threads) {
@@ -1001,6 +1005,10 @@ GoalForecast forecast(Scene& scene, double target, int threads) {
         f.final_round = last.spp;
         f.total = Prediction{pilots.samples + last.spp,
                              seconds + predicted_seconds(pilots.rounds, last.spp)};
+        if (const auto slow = predict(pilots.rounds, target, kMaxSamples, -0.5);
+            slow && slow->spp > last.spp) {
+            f.slow = Prediction{pilots.samples + slow->spp, seconds + slow->seconds};
+        }
     }
     return f;
 }
@@ -1022,6 +1030,10 @@ std::string forecast_text(const GoalForecast& f, double target) {
             text << (&r == &f.pilots[0] ? "" : ", ") << r.spp;
         if (f.final_round > 0) text << ", " << f.final_round;
         text << " spp)";
+        if (f.slow) {
+            text << "; if the error falls only as N^-1/2: " << f.slow->spp << " spp, " << std::fixed
+                 << std::setprecision(2) << f.slow->seconds << " s" << std::defaultfloat;
+        }
     } else {
         text << "n/a (the pilots give no error estimate to extrapolate)";
     }

@@ -16,7 +16,7 @@ command -v gnuplot >/dev/null || {
 }
 # Columns (goal-study.sh): 1 scene, 2 target, 3 predicted_spp, 4 predicted_s, 5 goal_spp,
 # 6 goal_rounds, 7 goal_s, 8 goal_render_s, 9 goal_estimated, 10 goal_true, 11 fixed_spp,
-# 12 fixed_s, 13 fixed_render_s, 14 fixed_true.
+# 12 fixed_s, 13 fixed_render_s, 14 fixed_true, 15 load.
 gnuplot <<EOF
 set terminal pngcairo size 1200,520 font "sans,10"
 set output "$png"
