@@ -11,7 +11,6 @@
 #include <filesystem>
 #include <initializer_list>
 #include <optional>
-#include <regex>
 #include <string>
 #include <vector>
 
@@ -29,6 +28,7 @@ namespace {
 namespace fs = std::filesystem;
 using test::Outcome;
 using test::read_bytes;
+using test::regex_all_groups;
 using test::regex_groups;
 using test::run_drt;
 
@@ -210,17 +210,6 @@ constexpr const char* kScene = R"(<?xml version="1.0"?>
   <Sphere Px="0" Py="1" Pz="0" Radius="1" Material="Grey"/>
 </Scene>
 )";
-
-// Group 1 of every match of `pattern` in `text`.
-std::vector<std::string> all_groups(const std::string& text, const std::string& pattern) {
-    std::vector<std::string> out;
-    const std::regex re(pattern);
-    for (auto it = std::sregex_iterator(text.begin(), text.end(), re); it != std::sregex_iterator();
-         ++it) {
-        out.push_back((*it)[1].str());
-    }
-    return out;
-}
 
 class GoalCli : public test::TempFolderTest {
   protected:
@@ -404,7 +393,7 @@ TEST_F(GoalCli, InfoPredictsTheSamplesAndTimeFromPilots) {
     ASSERT_EQ(groups.size(), 7u) << r.out;
     // The predicted samples are the rounds' together.
     int predicted = 0;
-    for (const auto& count : all_groups(groups[3], "([0-9]+)")) predicted += std::stoi(count);
+    for (const auto& count : regex_all_groups(groups[3], "([0-9]+)")) predicted += std::stoi(count);
     EXPECT_EQ(std::to_string(predicted), groups[2]) << r.out;
     // The render to the target takes the same rounds first (their errors are the same bits) and
     // more only where the predicted final round misses the target.
@@ -415,7 +404,7 @@ TEST_F(GoalCli, InfoPredictsTheSamplesAndTimeFromPilots) {
     const std::string stats = bytes("s.json");
     EXPECT_NE(stats.find("\"target_met\": true"), std::string::npos) << stats;
     std::string rounds;
-    for (const auto& count : all_groups(stats, "\\{\"spp\": ([0-9]+),")) {
+    for (const auto& count : regex_all_groups(stats, "\\{\"spp\": ([0-9]+),")) {
         rounds += (rounds.empty() ? "" : ", ") + count;
     }
     EXPECT_EQ(rounds.substr(0, groups[3].size()), groups[3]) << stats;

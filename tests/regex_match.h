@@ -26,6 +26,25 @@ inline std::vector<std::string> regex_groups(const std::string& text, const char
     return groups;
 }
 
+// Group 1 of every match of `pattern` (which must have a group) in `text`, left to right.
+inline std::vector<std::string> regex_all_groups(const std::string& text, const char* pattern) {
+    regex_t compiled;
+    if (regcomp(&compiled, pattern, REG_EXTENDED) != 0) throw std::invalid_argument(pattern);
+    if (compiled.re_nsub < 1) {
+        regfree(&compiled);
+        throw std::invalid_argument(pattern);
+    }
+    std::vector<std::string> out;
+    regmatch_t match[2];
+    for (const char* at = text.c_str(); *at != '\0';) {
+        if (regexec(&compiled, at, 2, match, at == text.c_str() ? 0 : REG_NOTBOL) != 0) break;
+        if (match[1].rm_so >= 0) out.emplace_back(at + match[1].rm_so, at + match[1].rm_eo);
+        at += match[0].rm_eo > 0 ? match[0].rm_eo : 1;  // an empty match moves on by one
+    }
+    regfree(&compiled);
+    return out;
+}
+
 // The length of the leftmost match of `pattern` in `text`, or -1.
 inline long regex_match_length(const std::string& text, const char* pattern) {
     const std::vector<std::string> groups = regex_groups(text, pattern);
