@@ -72,8 +72,8 @@ struct Prediction {
 // met), and its time from a line through the rounds' times. A round's own error is extrapolated
 // from the latest round with an estimate along the log-log slope from the latest earlier one at
 // most a third of its count (held between `steepest` and -1/4: rounds are noisy); without such a
-// round the slope is taken as -1/2, that of independent samples, which no sampler drt has falls
-// short of (stratified and Sobol patterns converge faster), so the count errs on the large side.
+// round the slope is `steepest` itself (-1 by default: the count errs on the short side, since a
+// shortfall costs only one small round more; next_round passes -1/2 after a final round missed).
 // A round smaller than that one's is extrapolated along -1 instead: a pattern's gain over
 // independent samples is smallest at few samples. With round_weight's weights the combined error
 // c' of one more round of error e is 1 / c'^2 = 1 / c^2 + 1 / e^2, c the rounds' combined
