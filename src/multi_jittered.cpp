@@ -191,19 +191,19 @@ class Grid {
         if (packed) {
             const std::uint32_t columns = listed_order(shape.m, digits);
             packed_sides = {columns, listed_order(shape.n, digits), shape.n, kPlaces[k].data()};
-        } else if (k <= kDealtUpTo) {
-            column = side(column_small_, column_large_, shape.m);
-            sub_column = side(sub_column_small_, sub_column_large_, shape.n);
-            shuffle(column, digits);
-            shuffle(sub_column, digits);
         } else {
             column = side(column_small_, column_large_, shape.m);
             sub_column = side(sub_column_small_, sub_column_large_, shape.n);
-            for (std::uint32_t c = 0; c < shape.m; ++c) {
-                column[c] = permute(c, shape.m, key * 0x68bc21ebu);
-            }
-            for (std::uint32_t r = 0; r < shape.n; ++r) {
-                sub_column[r] = permute(r, shape.n, key * 0x02e5be93u);
+            if (k <= kDealtUpTo) {
+                shuffle(column, digits);
+                shuffle(sub_column, digits);
+            } else {
+                for (std::uint32_t c = 0; c < shape.m; ++c) {
+                    column[c] = permute(c, shape.m, key * 0x68bc21ebu);
+                }
+                for (std::uint32_t r = 0; r < shape.n; ++r) {
+                    sub_column[r] = permute(r, shape.n, key * 0x02e5be93u);
+                }
             }
         }
         rotation = k <= 4096 ? digits.below(k) : static_cast<std::uint32_t>(((h >> 32) * k) >> 32);
