@@ -2,7 +2,6 @@
 
 #include <immintrin.h>
 #include <algorithm>
-#include <atomic>
 #include <limits>
 #include <optional>
 
@@ -129,23 +128,23 @@ class Builder {
         }
         std::uint32_t second_index = 0;
         if (tasks > 1 && count >= kParallelBuild) {
-            // The two subtrees on two threads, the second into nodes of its own, then appended
-            // after the first: where the sequential build would have put it, node for node.
-            // (run_on_threads hands an exception on either thread, say std::bad_alloc, back to
-            // the caller, where one leaving a thread of its own would end the program.)
+            // The first subtree on this thread and the second on a new one, into nodes of its
+            // own, then appended after the first: where the sequential build would have put it,
+            // node for node. (fork_join hands an exception on either thread, say
+            // std::bad_alloc, back to the caller, where one leaving a thread of its own would end
+            // the program.)
             std::vector<BinaryNode> second_nodes;
-            std::atomic<int> next_half{0};
-            run_on_threads(2, [&](const std::atomic<bool>&) {
-                if (next_half.fetch_add(1) == 0) {
+            fork_join(
+                [&] {
+                    if (!known) first = extent_of(items_, begin, mid);
+                    build(begin, mid, first, depth + 1, nodes, tasks - tasks / 2);
+                },
+                [&] {
                     if (!known) second = extent_of(items_, mid, end);
                     second_nodes.reserve(2 * (end - mid));
                     prefer_huge_pages(second_nodes);
                     build(mid, end, second, depth + 1, second_nodes, tasks / 2);
-                } else {
-                    if (!known) first = extent_of(items_, begin, mid);
-                    build(begin, mid, first, depth + 1, nodes, tasks - tasks / 2);
-                }
-            });
+                });
             second_index = static_cast<std::uint32_t>(nodes.size());
             for (BinaryNode n : second_nodes) {
                 if (n.count == 0) n.offset += second_index;

@@ -52,4 +52,19 @@ void run_on_threads(int threads, const std::function<void(const std::atomic<bool
     if (error) std::rethrow_exception(error);
 }
 
+void fork_join(const std::function<void()>& first, const std::function<void()>& second) {
+    std::exception_ptr error;  // second's; read once the thread has been joined
+    {
+        const std::jthread other([&] {
+            try {
+                second();
+            } catch (...) {
+                error = std::current_exception();
+            }
+        });
+        first();  // should it throw, leaving this block joins the thread before the rethrow
+    }
+    if (error) std::rethrow_exception(error);
+}
+
 }  // namespace drt

@@ -1,5 +1,6 @@
 // Work on several threads: every thread runs, the caller waits, and the first exception comes
-// back to the caller (instead of std::terminate) after the other threads have seen it and ended.
+// back to the caller (instead of std::terminate) after the other threads have seen it and ended;
+// a fork-join's two halves run at once, an exception from either coming back the same way.
 #include "drt/parallel.h"
 
 #include <gtest/gtest.h>
@@ -87,6 +88,63 @@ TEST(RunOnThreads, WaitingIsCalledMeanwhileAndItsExceptionStopsTheThreads) {
     }
     EXPECT_EQ(calls.load(), 3);
     EXPECT_EQ(saw.load(), 2);
+}
+
+TEST(ForkJoin, RunsTheFirstHereAndTheSecondOnAnotherThreadAtOnce) {
+    std::thread::id first_on, second_on;
+    std::atomic<int> arrived{0};
+    // Each waits for the other: the test hangs, not passes, if they ran one after another.
+    const auto meet = [&] {
+        ++arrived;
+        while (arrived.load() < 2) std::this_thread::yield();
+    };
+    fork_join(
+        [&] {
+            first_on = std::this_thread::get_id();
+            meet();
+        },
+        [&] {
+            second_on = std::this_thread::get_id();
+            meet();
+        });
+    EXPECT_EQ(first_on, std::this_thread::get_id());
+    EXPECT_NE(second_on, std::this_thread::get_id());
+}
+
+TEST(ForkJoin, AnExceptionFromEitherReachesTheCallerOnceBothHaveEnded) {
+    std::atomic<bool> other_ended{false};
+    try {
+        fork_join([] { throw std::runtime_error("first"); },
+                  [&] {
+                      std::this_thread::sleep_for(20ms);
+                      other_ended = true;
+                  });
+        FAIL() << "nothing was rethrown";
+    } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()), "first");
+        EXPECT_TRUE(other_ended.load());
+    }
+    other_ended = false;
+    try {
+        fork_join(
+            [&] {
+                std::this_thread::sleep_for(20ms);
+                other_ended = true;
+            },
+            [] { throw std::runtime_error("second"); });
+        FAIL() << "nothing was rethrown";
+    } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()), "second");
+        EXPECT_TRUE(other_ended.load());
+    }
+    // Both: the first's, the second's dropped.
+    try {
+        fork_join([] { throw std::runtime_error("first"); },
+                  [] { throw std::runtime_error("second"); });
+        FAIL() << "nothing was rethrown";
+    } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()), "first");
+    }
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // One function run on several threads at once, as the renderer's workers and the costly-first
-// pilot run: the caller waits, and an exception thrown on any thread comes back to it instead of
-// ending the program (an exception leaving a thread calls std::terminate).
+// pilot run, or two halves of a divided task at once, as a mesh's tree build: the caller waits,
+// and an exception thrown on any thread comes back to it instead of ending the program (an
+// exception leaving a thread calls std::terminate).
 #pragma once
 
 #include <atomic>
@@ -17,5 +18,10 @@ namespace drt {
 void run_on_threads(int threads, const std::function<void(const std::atomic<bool>& failed)>& work,
                     const std::function<void()>& waiting = nullptr,
                     std::chrono::milliseconds interval = std::chrono::milliseconds(250));
+
+// Runs `second` on one new thread while the calling thread runs `first`, and returns when both
+// have returned. An exception from either is rethrown here once both have ended; `first`'s when
+// both throw.
+void fork_join(const std::function<void()>& first, const std::function<void()>& second);
 
 }  // namespace drt
