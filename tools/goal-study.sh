@@ -5,12 +5,16 @@
 # - the cheapest fixed count whose true RMSE reaches E, found by doubling and then bisecting
 #   --spp N against a 4096-spp reference of another seed (assumes the error falls with N);
 # - the time of the goal render and of that fixed count, timed side by side and alternating,
-#   pinned to one core at high priority (run as root for nice -20), --repeat times each.
+#   pinned to one core at high priority (run as root for nice -20), --repeat times each; with
+#   --repeat 0 the goal render runs once, untimed (its rounds and errors are deterministic, so
+#   "goal samples / fixed" and the true error need no timing).
+# --sampler renders the goal and the fixed counts with that sampler (the reference is the same
+# for every sampler: the default one's at 4096 spp).
 # Writes goal-study.csv to the work folder and prints a markdown table;
 # tools/goal-plot.sh draws docs/images/accuracy-goal.png from the CSV.
 #
 # usage: tools/goal-study.sh [--drt BIN] [--scale S] [--targets E1,E2,..] [--work DIR]
-#                            [--repeat N] [--cpu C] [--scenes "test1 test2 .."]
+#                            [--repeat N] [--cpu C] [--scenes "test1 test2 .."] [--sampler S]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 drt=$root/build/drt
@@ -20,6 +24,7 @@ work=$root/build/goal-study
 repeat=3
 cpu=1
 scenes="test1 test2 test3 test4 test5 test6"
+sampler=stratified
 while [ $# -gt 0 ]; do
     case "$1" in
         --drt) drt=$(realpath "$2"); shift 2 ;;
@@ -29,6 +34,7 @@ while [ $# -gt 0 ]; do
         --repeat) repeat=$2; shift 2 ;;
         --cpu) cpu=$2; shift 2 ;;
         --scenes) scenes=$2; shift 2 ;;
+        --sampler) sampler=$2; shift 2 ;;
         *) echo "goal-study: unknown option $1" >&2; exit 2 ;;
     esac
 done
@@ -63,9 +69,9 @@ for name in $scenes; do
     # rmse_at N: the true RMSE of --spp N (kept in the work folder: it is called in subshells,
     # and the images of --spp N are the same for every build that renders them bit-identically).
     rmse_at() {
-        local kept=$work/$name-$scale.$1.rmse
+        local kept=$work/$name-$scale-$sampler.$1.rmse
         if [ ! -f "$kept" ]; then
-            "$drt" "$scene" --scale "$scale" --spp "$1" -q -o "$tmp/fixed.pfm"
+            "$drt" "$scene" --scale "$scale" --sampler "$sampler" --spp "$1" -q -o "$tmp/fixed.pfm"
             "$drt" compare "$tmp/fixed.pfm" "$ref" | sed 's/rmse=\([^ ]*\).*/\1/' >"$kept"
         fi
         cat "$kept"
@@ -80,19 +86,29 @@ for name in $scenes; do
         done
         fixed=$hi
         log "$name E=$target: cheapest fixed count $fixed (true RMSE $(rmse_at "$fixed"))"
-        pinned "$drt" info "$scene" --scale "$scale" --threads 1 --target-error "$target" >"$tmp/info.txt"
+        pinned "$drt" info "$scene" --scale "$scale" --sampler "$sampler" --threads 1 \
+            --target-error "$target" >"$tmp/info.txt"
         predicted=$(sed -n 's/^predicted for --target-error [^:]*: \([0-9]*\) spp, \([0-9.]*\) s.*/\1,\2/p' "$tmp/info.txt")
         goal_times="" fixed_times=""
         for ((k = 1; k <= repeat; k++)); do
-            wall t "$drt" "$scene" --scale "$scale" --threads 1 --target-error "$target" \
-                -o "$tmp/goal.pfm" --stats "$tmp/goal.json"
+            wall t "$drt" "$scene" --scale "$scale" --sampler "$sampler" --threads 1 \
+                --target-error "$target" -o "$tmp/goal.pfm" --stats "$tmp/goal.json"
             goal_times+=" $t"
-            wall t "$drt" "$scene" --scale "$scale" --threads 1 --spp "$fixed" \
+            wall t "$drt" "$scene" --scale "$scale" --sampler "$sampler" --threads 1 --spp "$fixed" \
                 -o "$tmp/fixed.pfm" --stats "$tmp/fixed.json"
             fixed_times+=" $t"
         done
-        goal_s=$(echo $goal_times | median)
-        fixed_s=$(echo $fixed_times | median)
+        if [ "$repeat" -eq 0 ]; then
+            "$drt" "$scene" --scale "$scale" --sampler "$sampler" --target-error "$target" \
+                -o "$tmp/goal.pfm" --stats "$tmp/goal.json" 2>/dev/null
+            "$drt" "$scene" --scale "$scale" --sampler "$sampler" --spp "$fixed" \
+                -o "$tmp/fixed.pfm" --stats "$tmp/fixed.json" 2>/dev/null
+        fi
+        goal_s=nan fixed_s=nan
+        if [ "$repeat" -gt 0 ]; then
+            goal_s=$(echo $goal_times | median)
+            fixed_s=$(echo $fixed_times | median)
+        fi
         goal_spp=$(json samples_per_pixel "$tmp/goal.json")
         rounds=$(grep -o '"spp": [0-9]*' "$tmp/goal.json" | sed 's/"spp": //' | paste -sd' ')
         estimated=$(json estimated_rmse "$tmp/goal.json")
@@ -108,8 +124,10 @@ echo "| scene | E | predicted spp | predicted s | goal rounds (spp) | goal s | g
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 tail -n +2 "$csv" | while IFS=, read -r name target pspp ps gspp rounds gs grs gest gtrue fspp fs frs ftrue load; do
     samples=$(echo "${rounds// /+}" | bc)
+    walls=nan
+    [ "$gs" = nan ] || walls=$(echo "$gs / $fs" | bc -l)
     printf '| %s | %s | %s | %.2f | %s | %.2f | %.5f | %.5f | %.2f | %s | %.2f | %.2f | %.2f | %s |\n' \
         "$name" "$target" "$pspp" "$ps" "${rounds// /, }" "$gs" "$gest" "$gtrue" \
         "$(echo "$gtrue / $target" | bc -l)" "$fspp" "$fs" "$(echo "$samples / $fspp" | bc -l)" \
-        "$(echo "$gs / $fs" | bc -l)" "$load"
+        "$walls" "$load"
 done
