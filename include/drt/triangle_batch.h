@@ -9,7 +9,9 @@
 // else (a ray within rounding of an edge or a vertex, of the range's ends, or a float overflow,
 // whose NaN fails every comparison that would rule a triangle out) goes on to the double test,
 // which decides as before. So the hits, their t and their barycentrics are bit for bit those of
-// testing every triangle in double, and the mesh stays watertight.
+// testing every triangle in double, and the mesh stays watertight. The same bounds read the
+// other way prove a hit (edge functions certainly of one sign, t certainly inside the range and
+// past the double test's own error bound for t): an any-hit query can answer from that alone.
 //
 // The bounds, with u = 2^-24 the unit round-off of float, and per triangle X, Y, Z the largest
 // |sheared x|, |sheared y| and |z| of its corners relative to the ray's origin:
@@ -85,6 +87,27 @@ class FloatShearedRay {
     // Bit k set unless triangle k certainly misses inside [near, far] (near ≥ 0 or -∞; far may
     // be +∞). The corners' magnitudes must not exceed kLargest.
     int maybe_hits(const TriangleBatch& batch, float near, float far) const {
+        return test<false>(batch, near, far, 0, 0).maybe;
+    }
+
+    // maybe_hits, and beside it `certain`: bit k set only where the double test certainly hits
+    // triangle k inside a range that [low, high] lies within (low ≥ the range's start, high ≤
+    // its end; low may be 0 for a range that starts at or below 0). A query that asks only
+    // whether anything is hit can answer from it alone.
+    struct Verdict {
+        int maybe, certain;
+    };
+    Verdict classify(const TriangleBatch& batch, float near, float far, float low,
+                     float high) const {
+        return test<true>(batch, near, far, low, high);
+    }
+
+    // Coordinates of larger magnitude, in the mesh or in the ray's origin, turn the filter off.
+    static constexpr float kLargest = 1e15f;
+
+  private:
+    template <bool kCertain>
+    Verdict test(const TriangleBatch& batch, float near, float far, float low, float high) const {
         const auto& corners = batch.corners;
         const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
         const auto abs = [&](__m128 v) { return _mm_and_ps(v, abs_mask); };
@@ -158,13 +181,48 @@ class FloatShearedRay {
             _mm_cmpgt_ps(det_lo, _mm_setzero_ps()),
             _mm_cmple_ps(_mm_mul_ps(_mm_add_ps(scaled, scaled_err), _mm_set1_ps(1 + 0x1p-20f)),
                          _mm_mul_ps(_mm_set1_ps(near), _mm_mul_ps(det_lo, round_down))));
-        return ~_mm_movemask_ps(_mm_or_ps(outside, _mm_or_ps(beyond, behind))) & 0xf;
+        const int maybe = ~_mm_movemask_ps(_mm_or_ps(outside, _mm_or_ps(beyond, behind))) & 0xf;
+        if constexpr (!kCertain) {
+            return {maybe, 0};
+        } else {
+            // The mirror image of the tests above: all three edge functions certainly of one
+            // sign (so det is not 0 either), t certainly above `low` and below `high`.
+            const __m128 one_sign = _mm_or_ps(
+                _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(e0, edge_err), _mm_cmpgt_ps(e1, edge_err)),
+                           _mm_cmpgt_ps(e2, edge_err)),
+                _mm_and_ps(_mm_and_ps(_mm_cmplt_ps(e0, minus_err), _mm_cmplt_ps(e1, minus_err)),
+                           _mm_cmplt_ps(e2, minus_err)));
+            const __m128 t_det_lo = _mm_mul_ps(_mm_sub_ps(scaled, scaled_err), round_down);
+            const __m128 above_low = _mm_cmpgt_ps(t_det_lo, _mm_mul_ps(_mm_set1_ps(low), det_hi));
+            const __m128 below_high =
+                _mm_cmplt_ps(_mm_mul_ps(_mm_add_ps(scaled, scaled_err), _mm_set1_ps(1 + 0x1p-20f)),
+                             _mm_mul_ps(_mm_set1_ps(high), _mm_mul_ps(det_lo, round_down)));
+            // The double test also misses a hit no farther than the rounding error of its own t,
+            // delta_t = 3·(γ3·Me·Mz + δe·Mz + γ3·Mz·Me)·|1 / det| (triangle.h), with Mx, My, Mz
+            // and Me the largest |sheared x|, |y|, |sz·z| and |edge function| in double and
+            // δe = 2·(γ2·Mx·My + γ5·(My + Mz)·Mx + γ5·(Mx + Mz)·My). With every γ below 2^-50,
+            // delta_t·|det| ≤ 6·2^-50·Mz·(Me + 3·Mx·My + Mz·(Mx + My)); the bound B below is
+            // 2^-45·Mz·(...), over 5 times that, which covers the float rounding here and the
+            // double test's, with each double value bounded by its float one plus its error
+            // bound. Where |det| is known to within a quarter, det_hi < 2·det_lo, and
+            // t·|det| > 4·B proves t > delta_t (and t > 0, so a range starting below 0 is met).
+            const __m128 mx = _mm_add_ps(big_x, delta), my = _mm_add_ps(big_y, delta);
+            const __m128 mz = _mm_mul_ps(_mm_mul_ps(abs(sz_), _mm_add_ps(big_z, delta)),
+                                         _mm_set1_ps(1 + 0x1p-20f));
+            const __m128 me = _mm_add_ps(max3(abs(e0), abs(e1), abs(e2)), edge_err);
+            const __m128 t_err_bound = _mm_mul_ps(
+                _mm_mul_ps(_mm_set1_ps(4 * 0x1p-45f), mz),
+                _mm_add_ps(_mm_add_ps(me, _mm_mul_ps(_mm_set1_ps(3), _mm_mul_ps(mx, my))),
+                           _mm_mul_ps(mz, _mm_add_ps(mx, my))));
+            const __m128 det_known = _mm_cmplt_ps(_mm_mul_ps(_mm_set1_ps(4), det_err), abs(det));
+            const __m128 past_own_error = _mm_cmpgt_ps(t_det_lo, t_err_bound);
+            const __m128 certain =
+                _mm_and_ps(_mm_and_ps(one_sign, det_known),
+                           _mm_and_ps(_mm_and_ps(above_low, below_high), past_own_error));
+            return {maybe, _mm_movemask_ps(certain)};
+        }
     }
 
-    // Coordinates of larger magnitude, in the mesh or in the ray's origin, turn the filter off.
-    static constexpr float kLargest = 1e15f;
-
-  private:
     int kx_, ky_, kz_;
     bool usable_ = true;
     __m128 origin_[3];
