@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <ostream>
 
 #include "drt/atomic_file.h"
 #include "drt/limits.h"
@@ -115,6 +116,22 @@ std::optional<AdaptiveSampling> AdaptiveFlags::settings() const {
 
 void write_text_atomically(const std::filesystem::path& path, const std::string& text) {
     replace_file(path, text + "\n");
+}
+
+std::optional<int> parse_arguments(CLI::App& app, int argc, const char* const* argv,
+                                   const std::string& command, std::ostream& out,
+                                   std::ostream& err) {
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp&) {
+        out << app.help();
+        return kOk;
+    } catch (const CLI::ParseError& e) {
+        err << command << ": " << printable(e.what()) << "\nRun '" << command
+            << " --help' for usage.\n";
+        return kBadInput;
+    }
+    return std::nullopt;
 }
 
 }  // namespace drt::cli

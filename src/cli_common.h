@@ -43,6 +43,12 @@ CLI::Validator integer_in(long long lowest, unsigned long long limit);
 // A finite number above zero (CLI::PositiveNumber lets "nan" and "inf" through).
 CLI::Validator finite_positive();
 
+// Parses a subcommand's arguments: its help on `out` (exit kOk), or a parse error on `err` with a
+// pointer to `COMMAND --help` (exit kBadInput); nothing when the command should go on.
+std::optional<int> parse_arguments(CLI::App& app, int argc, const char* const* argv,
+                                   const std::string& command, std::ostream& out,
+                                   std::ostream& err);
+
 // Command-line settings that override the scene's <Image> and <Render>.
 struct Overrides {
     std::optional<int> spp, shadow_rays, width, height, glossy_rays, max_depth;

@@ -31,15 +31,8 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
     app.add_option("--report", report_dir,
                    "Write DIR/index.html showing B (the reference), A (the render) and their "
                    "difference with the measures");
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::CallForHelp&) {
-        out << app.help();
-        return kOk;
-    } catch (const CLI::ParseError& e) {
-        err << "drt compare: " << printable(e.what()) << "\nRun 'drt compare --help' for usage.\n";
-        return kBadInput;
-    }
+    if (const auto status = parse_arguments(app, argc, argv, "drt compare", out, err))
+        return *status;
     Comparison c;
     Image image_a, image_b;
     try {

@@ -84,15 +84,7 @@ int info_command(int argc, const char* const* argv, std::ostream& out, std::ostr
         ->check(finite_positive());
     app.add_option("--threads", threads, "Worker threads of the pilot renders (default: all cores)")
         ->check(integer_in(1, kMaxThreads));
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::CallForHelp&) {
-        out << app.help();
-        return kOk;
-    } catch (const CLI::ParseError& e) {
-        err << "drt info: " << printable(e.what()) << "\nRun 'drt info --help' for usage.\n";
-        return kBadInput;
-    }
+    if (const auto status = parse_arguments(app, argc, argv, "drt info", out, err)) return *status;
     try {
         LoadedScene loaded = load_scene(scene_path);
         for (const std::string& w : loaded.warnings) err << w << "\n";
