@@ -4,6 +4,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "cli_common.h"
 #include "drt/limits.h"
@@ -47,18 +48,21 @@ std::string forecast_text(const GoalForecast& f, double target) {
     std::ostringstream text;
     text << "pilots:";
     for (const ProgressiveRound& r : f.pilots) {
-        text << " " << r.spp << " spp " << std::fixed << std::setprecision(3) << r.seconds
-             << " s, estimated rmse " << std::defaultfloat
-             << (r.error ? short_number(*r.error) : std::string("n/a")) << ";";
+        text << " " << r.spp << " spp";
+        if (!r.full()) text << " on 1 pixel in " << r.pixel_block * r.pixel_block << ",";
+        text << " " << std::fixed << std::setprecision(3) << r.seconds << " s, estimated rmse "
+             << std::defaultfloat << (r.error ? short_number(*r.error) : std::string("n/a")) << ";";
     }
     text << "\npredicted for --target-error " << short_number(target) << ": ";
     if (f.total) {
         // The goal render repeats the pilots, then adds the final round to them.
         text << f.total->spp << " spp, " << std::fixed << std::setprecision(2) << f.total->seconds
              << " s on this machine (rounds of " << std::defaultfloat;
-        for (const ProgressiveRound& r : f.pilots)
-            text << (&r == &f.pilots[0] ? "" : ", ") << r.spp;
-        if (f.final_round > 0) text << ", " << f.final_round;
+        const char* separator = "";
+        for (const ProgressiveRound& r : f.pilots) {
+            if (r.full()) text << std::exchange(separator, ", ") << r.spp;
+        }
+        if (f.final_round > 0) text << separator << f.final_round;
         text << " spp)";
         if (f.slow) {
             text << "; if the error falls only as N^-1/2: " << f.slow->spp << " spp, " << std::fixed

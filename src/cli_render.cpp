@@ -173,8 +173,17 @@ class SignalStop {
 std::string goal_summary(const std::string& name, const ProgressiveResult& p, const GoalFlags& goal,
                          double seconds) {
     std::ostringstream line;
-    line << "drt: " << name << ": " << p.samples << " spp after rounds of ";
-    for (std::size_t i = 0; i < p.rounds.size(); ++i) line << (i ? ", " : "") << p.rounds[i].spp;
+    line << "drt: " << name << ": " << p.samples << " spp after ";
+    const char* separator = "rounds of ";
+    for (const ProgressiveRound& r : p.rounds) {
+        if (!r.full()) {
+            line << "a pilot of " << r.spp << " spp on 1 pixel in " << r.pixel_block * r.pixel_block
+                 << ", ";
+            continue;
+        }
+        line << separator << r.spp;
+        separator = ", ";
+    }
     line << " spp; estimated rmse " << (p.error ? short_number(*p.error) : std::string("n/a"));
     if (goal.target_error) {
         line << " (target " << short_number(*goal.target_error)
@@ -184,7 +193,10 @@ std::string goal_summary(const std::string& name, const ProgressiveResult& p, co
         line << "; " << std::fixed << std::setprecision(2) << seconds << " s of the "
              << short_number(*goal.time_limit) << " s limit" << std::defaultfloat;
     }
-    if (!p.combined) {
+    const auto full = std::count_if(p.rounds.begin(), p.rounds.end(),
+                                    [](const ProgressiveRound& r) { return r.full(); });
+    if (!p.combined || full == 1) {
+        // A target error's one full round is the plain render of its count (progressive.h).
         line << "\ndrt: " << name << ": --spp " << p.samples
              << " renders the same image (bit-identical) without a goal\n";
     } else {

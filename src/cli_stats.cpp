@@ -49,12 +49,17 @@ std::string goal_json(const ProgressiveResult& p, const std::optional<double>& t
       << ", \"time_limit\": " << (limit ? json_number(*limit) : "null")
       << ", \"target_met\": " << json_bool(p.target_met)
       << ", \"combined\": " << json_bool(p.combined) << ", \"rounds\": [";
+    std::size_t full = 0;
     for (std::size_t i = 0; i < p.rounds.size(); ++i) {
         const ProgressiveRound& r = p.rounds[i];
         j << (i ? ", " : "") << "{\"spp\": " << r.spp;
-        // The seed renders the round alone (--spp N --seed S): a string, as 64 bits are beyond
-        // a JSON number's exact range.
-        if (p.combined) j << ", \"seed\": \"" << round_seed(seed, i) << "\"";
+        // A pilot of one pixel in b x b is not part of the image. A full round's seed renders it
+        // alone (--spp N --seed S): a string, as 64 bits are beyond a JSON number's exact range.
+        if (!r.full()) {
+            j << ", \"pilot_pixel_block\": " << r.pixel_block;
+        } else if (p.combined) {
+            j << ", \"seed\": \"" << round_seed(seed, full++) << "\"";
+        }
         j << ", \"seconds\": " << json_number(r.seconds)
           << ", \"estimated_rmse\": " << (r.error ? json_number(*r.error) : "null") << "}";
     }

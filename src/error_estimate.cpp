@@ -137,7 +137,8 @@ void add_calibration(ErrorSums& sums, const Color& first, const Color& second, c
 }
 
 ErrorEstimate estimate_error(const Image& image, const Image& spread, const ErrorSums& sums,
-                             std::uint64_t samples, int spp, SpreadKind kind) {
+                             std::uint64_t samples, int spp, SpreadKind kind,
+                             std::uint64_t pixels) {
     if (image.width != spread.width || image.height != spread.height) {
         throw ImageError("the spread image is " + std::to_string(spread.width) + "x" +
                          std::to_string(spread.height) + ", the image " +
@@ -179,7 +180,8 @@ ErrorEstimate estimate_error(const Image& image, const Image& spread, const Erro
         mse += v;
         relmse += v / (std::max(0.0, x * x - v) + 0.01);
     }
-    const double count = std::max(1.0, 3.0 * image.width * image.height);
+    const double count =
+        std::max(1.0, 3.0 * (pixels > 0 ? double(pixels) : double(image.width) * image.height));
     e.rmse = std::sqrt(mse / count);
     e.relmse = relmse / count;
     return e;

@@ -33,6 +33,15 @@ constexpr double kIndependentSlope = -0.5;
 // to -0.83 (Test4) from 2 to 8 spp, where these top-up rounds lie; -1, taken before, assumed a
 // steeper rise than any scene's and so sized them larger than needed (docs/accuracy.md, section 6).
 constexpr double kSmallRoundSlope = -0.75;
+// The first full round after a pilot of some pixels aims at this share of the target, and toward
+// more samples than the pilot's along kPilotSlope (toward fewer along kSmallRoundSlope, as any
+// smaller round): the pilot's estimate scatters more than a full round's (0.8-1.4 of the image's
+// on the thesis scenes at --scale 0.25, 1,200 pixels), and a full round that falls short is
+// topped up by a second pattern, whose split costs the steep scenes 20-50 % where the margin
+// costs about 6 %; -0.8 lies among the thesis scenes' stratified slopes above 8 spp. Measured
+// against other shares, slopes and pilot sizes in docs/accuracy.md, section 6.
+constexpr double kPilotSpareShare = 0.95;
+constexpr double kPilotSlope = -0.8;
 // Of the time left, what a round may be predicted to take: the rest absorbs the prediction's
 // error.
 constexpr double kTimeShare = 0.9;
@@ -53,16 +62,16 @@ struct Line {
     double setup = 0, per_sample = 0;
 };
 
-// Seconds against samples through the last two rounds; set-up and a cost per sample, neither
-// negative, so a noisy pair of times never predicts a free sample.
+// Seconds against samples per image pixel through the last two rounds; set-up and a cost per
+// sample, neither negative, so a noisy pair of times never predicts a free sample.
 Line time_line(const std::vector<ProgressiveRound>& rounds) {
     const ProgressiveRound& last = rounds.back();
-    Line line{0, last.seconds / std::max(1, last.spp)};
+    Line line{0, last.seconds / last.cost()};
     if (rounds.size() < 2) return line;
     const ProgressiveRound& before = rounds[rounds.size() - 2];
-    if (last.spp <= before.spp) return line;
-    const double slope = (last.seconds - before.seconds) / (last.spp - before.spp);
-    const double setup = last.seconds - slope * last.spp;
+    if (last.cost() <= before.cost()) return line;
+    const double slope = (last.seconds - before.seconds) / (last.cost() - before.cost());
+    const double setup = last.seconds - slope * last.cost();
     if (slope <= 0 || setup < 0) return line;
     return {setup, slope};
 }
@@ -146,12 +155,24 @@ class Combination {
     std::string unavailable_;  // why a round had no estimate
 };
 
+// The calibration share of the last full round; 0 before one.
+double full_round_calibration(const std::vector<ProgressiveRound>& rounds) {
+    const auto last = std::find_if(rounds.rbegin(), rounds.rend(),
+                                   [](const ProgressiveRound& r) { return r.full(); });
+    return last == rounds.rend() ? 0 : last->calibration;
+}
+
 }  // namespace
 
 double predicted_seconds(const std::vector<ProgressiveRound>& rounds, int spp) {
     if (rounds.empty()) return 0;
     const Line line = time_line(rounds);
-    return line.setup + line.per_sample * spp;
+    return line.setup + line.per_sample * spp * (1 + full_round_calibration(rounds));
+}
+
+int pilot_block(int width, int height) {
+    const auto b = static_cast<int>(std::sqrt(double(width) * height / kPilotPixels));
+    return b < kMinPilotBlock ? 1 : std::min(b, kMaxPilotBlock);
 }
 
 std::uint64_t round_seed(std::uint64_t seed, std::size_t round) {
@@ -164,18 +185,31 @@ double round_weight(const std::optional<double>& error, int spp) {
 
 int total_samples(const std::vector<ProgressiveRound>& rounds) {
     int total = 0;
-    for (const ProgressiveRound& r : rounds) total += r.spp;
+    for (const ProgressiveRound& r : rounds) total += r.full() ? r.spp : 0;
     return total;
 }
 
 std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, double target,
                                   int max_samples, double steepest) {
+    // The image's estimate so far; none before the first full round.
+    std::optional<double> now;
+    bool image = false;
+    for (const ProgressiveRound& r : rounds) {
+        if (r.full()) {
+            image = true;
+            now = r.combined;
+        }
+    }
+    // A pilot of some pixels only until a full round measures the image: its estimate scatters
+    // more, and a slope from it to a full round's would carry that scatter (30 % low, a slope of
+    // -0.29 and a last round 3 times too large on a soft-shadow scene at 128 x 128).
     std::vector<const ProgressiveRound*> measured;
     for (const ProgressiveRound& r : rounds) {
-        if (r.error && *r.error > 0 && std::isfinite(*r.error)) measured.push_back(&r);
+        if (r.full() == image && r.error && *r.error > 0 && std::isfinite(*r.error)) {
+            measured.push_back(&r);
+        }
     }
-    const std::optional<double> now = rounds.back().combined;
-    if (measured.empty() || !now) return std::nullopt;
+    if (measured.empty() || (image && !now)) return std::nullopt;
     // The largest round's error is the least noisy to extrapolate from, and the largest of
     // those at most a kMinSlopeSpan-th of its count gives the slope: over a narrower span the
     // errors' noise decides it. Stable sorts keep the latest of equal counts last.
@@ -191,11 +225,13 @@ std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, d
     }
     const double total = total_samples(rounds);
     const double left = max_samples - total;
-    if (*now <= target || left < kMinRound) return Prediction{0, 0};
+    if ((now && *now <= target) || left < kMinRound) return Prediction{0, 0};
     // Rounds weighted by the inverse of their estimated variance combine to 1 / c^2, the sum of
     // 1 / e^2 over the rounds: the next reaches the goal with the error `wanted`.
-    const double goal = kSpareShare * target;
-    const double wanted = 1 / std::sqrt(1 / (goal * goal) - 1 / (*now * *now));
+    // The first full round after a pilot of some pixels: see kPilotSpareShare.
+    if (!image && a == measured.rend()) slope = kPilotSlope;
+    const double goal = (image ? kSpareShare : kPilotSpareShare) * target;
+    const double wanted = now ? 1 / std::sqrt(1 / (goal * goal) - 1 / (*now * *now)) : goal;
     // Along the slope from b's error, or for a round smaller than b's along kSmallRoundSlope,
     // whatever the slope measured above it: a pattern's gain over independent samples is smallest
     // at few samples, yet a stratified pixel's error still rises steeper than 1 / sqrt(n) below
@@ -239,47 +275,60 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
     ProgressiveResult out;
     out.combined = goal.target_error.has_value();
     std::optional<Combination> combination;
+    // A pilot of some pixels first, where the image is large enough; never under a time limit
+    // alone, whose rounds replace one another.
+    int block = out.combined && goal.max_samples >= kFirstPilot
+                    ? pilot_block(scene.settings.width, scene.settings.height)
+                    : 1;
+    std::size_t full_rounds = 0;
     int spp = std::min(kFirstPilot, goal.max_samples);
-    for (std::size_t round = 0; spp > 0; ++round) {
+    while (spp > 0) {
         scene.settings.samples = spp;
-        if (out.combined) scene.settings.seed = round_seed(seed, round);
-        // Dropped when the budget runs out before it is done, except the first: without it
-        // there would be no image at all.
+        if (out.combined) scene.settings.seed = round_seed(seed, full_rounds);
+        // Dropped when the budget runs out before it is done, except the first full round:
+        // without it there would be no image at all.
         std::stop_source stopper;
         const std::stop_callback relay(options.stop, [&] { stopper.request_stop(); });
         std::optional<Alarm> alarm;
-        if (goal.time_limit && leader && round > 0) {
+        if (goal.time_limit && leader && full_rounds > 0) {
             alarm.emplace(goal.start + std::chrono::duration_cast<Clock::duration>(
                                            std::chrono::duration<double>(*goal.time_limit)),
                           stopper);
         }
         RenderJobOptions run = options;
         run.stop = stopper.get_token();
+        run.pixel_block = block;
+        // Ordering a pilot's tiles by cost would trace a sixteenth of a sample in every pixel:
+        // a fifth of what the pilot itself traces at one pixel in 25.
+        run.costly_first = options.costly_first && block == 1;
         RenderJobResult job = run_render_job(scene, run);
         alarm.reset();
         int next = 0;
         if (!leader) {
-            out.job = std::move(job);
+            if (block == 1) out.job = std::move(job);
         } else if (!job.complete()) {
             out.stopped = options.stop.stop_requested();
-            if (out.rounds.empty()) out.job = std::move(job);
+            if (full_rounds == 0) out.job = std::move(job);
         } else {
-            ProgressiveRound done{spp, job.render.stats.seconds, estimated_error(job.render),
-                                  std::nullopt};
-            if (out.combined) {
-                if (!combination)
-                    combination.emplace(job.render.image.width, job.render.image.height);
-                combination->add(job.render, spp);
-                job.render = combination->result(job.render);
+            ProgressiveRound done{
+                spp,   job.render.stats.seconds,   estimated_error(job.render), std::nullopt,
+                block, job.render.stats.error.cost};
+            // A pilot of some pixels is measured, not kept.
+            if (done.full()) {
+                if (out.combined) {
+                    if (!combination)
+                        combination.emplace(job.render.image.width, job.render.image.height);
+                    combination->add(job.render, spp);
+                    job.render = combination->result(job.render);
+                }
+                done.combined = estimated_error(job.render);
+                out.job = std::move(job);
+                out.error = done.combined;
+                out.target_met =
+                    goal.target_error && done.combined && *done.combined <= *goal.target_error;
             }
-            done.combined = estimated_error(job.render);
             out.rounds.push_back(done);
-            out.job = std::move(job);
-            out.samples = total_samples(out.rounds);
-            if (!out.combined) out.samples = spp;
-            out.error = done.combined;
-            out.target_met =
-                goal.target_error && done.combined && *done.combined <= *goal.target_error;
+            out.samples = out.combined ? total_samples(out.rounds) : spp;
             if (goal.target_error) {
                 const NextRound n = next_round(out.rounds, *goal.target_error, goal.max_samples);
                 next = n.final && goal.pilots_only ? 0 : n.spp;
@@ -289,14 +338,19 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
             if (goal.time_limit && next > 0) {
                 const Line line = time_line(out.rounds);
                 const double fits =
-                    std::floor((kTimeShare * seconds_left() - line.setup) / line.per_sample);
+                    std::floor((kTimeShare * seconds_left() - line.setup) / line.per_sample /
+                               (1 + full_round_calibration(out.rounds)));
                 // Combined rounds: whatever fits adds samples. A round replacing the last: only
-                // one a quarter larger is worth its time.
+                // one a quarter larger is worth its time. After a pilot, the first full round
+                // whatever the time: the image.
                 const double least = out.combined ? kMinRound : 1.25 * spp;
                 if (fits < next) next = fits >= least ? static_cast<int>(fits) : 0;
+                if (!done.full()) next = std::max(next, kMinRound);
             }
         }
         spp = options.mpi ? options.mpi->leaders(next) : next;
+        if (block == 1) ++full_rounds;
+        block = 1;
     }
     return out;
 }

@@ -55,7 +55,7 @@ std::unique_ptr<Sampler> sampler_named(const std::string& name) {
 }  // namespace
 
 RenderContext::RenderContext(const Scene& scene, std::optional<AdaptiveSampling> adaptive,
-                             bool estimate_error)
+                             bool estimate_error, int pixel_block)
     : scene_(scene),
       sampler_(sampler_named(scene.settings.sampler)),
       plan_(plan_render(scene)),
@@ -63,10 +63,27 @@ RenderContext::RenderContext(const Scene& scene, std::optional<AdaptiveSampling>
       integrator_(scene, plan_, bvh_, *sampler_),
       adaptive_(adaptive),
       estimate_error_(estimate_error),
+      pixel_block_(std::max(1, pixel_block)),
       tiles_(tile_grid(scene.settings.width, scene.settings.height)) {
     if (adaptive_) {
         adaptive_->min_samples = std::clamp(adaptive_->min_samples, 1, scene.settings.samples);
     }
+    for (int y = 0; y < scene.settings.height; ++y) {
+        for (int x = 0; x < scene.settings.width; ++x) rendered_pixels_ += renders(x, y) ? 1 : 0;
+    }
+}
+
+// Keeps the pilot's choice of pixels apart from other hashes of the seed.
+constexpr std::uint64_t kPixelBlockStream = 0x706c6f74ULL;
+
+bool RenderContext::renders(int x, int y) const {
+    if (pixel_block_ == 1) return true;
+    const auto b = static_cast<std::uint64_t>(pixel_block_);
+    const std::uint64_t place =
+        hash_of(scene_.settings.seed, kPixelBlockStream, static_cast<std::uint64_t>(x) / b,
+                static_cast<std::uint64_t>(y) / b) %
+        (b * b);
+    return place == (static_cast<std::uint64_t>(y) % b) * b + static_cast<std::uint64_t>(x) % b;
 }
 
 SpreadKind RenderContext::spread_kind() const {
@@ -83,7 +100,8 @@ TileBuffer RenderContext::render_tile(const Tile& tile) const {
     rendered.reserve(buffer.pixel_samples.capacity());
     for (int y = tile.y0; y < tile.y1; ++y) {
         for (int x = tile.x0; x < tile.x1; ++x) {
-            const Pixel& pixel = rendered.emplace_back(render_pixel(x, y, 0, scratch, buffer.rays));
+            const Pixel& pixel = rendered.emplace_back(
+                renders(x, y) ? render_pixel(x, y, 0, scratch, buffer.rays) : Pixel{});
             buffer.pixels.set(x - tile.x0, y - tile.y0, pixel.value);
             buffer.spread.set(x - tile.x0, y - tile.y0, pixel.spread);
             buffer.pixel_samples.push_back(pixel.samples);
@@ -126,8 +144,12 @@ constexpr std::uint64_t kCalibrationPath = 0xca11b4a7e5eedULL;
 
 void RenderContext::calibrate(const Tile& tile, std::span<const Pixel> rendered, Scratch& scratch,
                               TileBuffer& buffer) const {
-    const std::vector<double> odds = calibration_odds(
-        buffer.spread, calibration_share(double(scene_.settings.width) * scene_.settings.height));
+    // A pilot's pixels lie apart, so odds that follow a neighbourhood's spread mean nothing
+    // there: all of them get the same.
+    const double share = calibration_share(double(rendered_pixels_));
+    const std::vector<double> odds =
+        pixel_block_ == 1 ? calibration_odds(buffer.spread, share)
+                          : std::vector<double>(rendered.size(), std::min(1.0, share));
     // The second renders' rays stay out of the image's ray counts: they are the estimate's cost,
     // which the sums count in camera samples.
     RayCounts rays;
@@ -135,7 +157,8 @@ void RenderContext::calibrate(const Tile& tile, std::span<const Pixel> rendered,
     for (int y = tile.y0; y < tile.y1; ++y) {
         for (int x = tile.x0; x < tile.x1; ++x, ++i) {
             const auto pixel = static_cast<std::uint32_t>(y * scene_.settings.width + x);
-            if (to_unit(hash_of(scene_.settings.seed, pixel, kCalibrationPath)) >= odds[i]) {
+            if (!renders(x, y) ||
+                to_unit(hash_of(scene_.settings.seed, pixel, kCalibrationPath)) >= odds[i]) {
                 continue;
             }
             const Pixel again = render_pixel(x, y, kCalibrationPath, scratch, rays);

@@ -38,7 +38,8 @@ class StopAfter final : public TileSink {
 RenderJobResult run_render_job(const Scene& scene, const RenderJobOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     const RenderContext context(scene, options.adaptive,
-                                options.estimate_error || options.checkpoint.has_value());
+                                options.estimate_error || options.checkpoint.has_value(),
+                                options.pixel_block);
     const bool leader = options.mpi == nullptr || options.mpi->leader();
     RenderJobResult out;
     out.tiles = context.tiles().size();

@@ -74,9 +74,9 @@ RenderResult assembled(const RenderContext& context, const ImageSink& sink) {
     result.unfinished = sink.missing();
     result.spread = sink.spread();
     if (result.unfinished.empty()) {
-        result.stats.error =
-            estimate_error(result.image, result.spread, sink.error_sums(), sink.samples(),
-                           context.scene().settings.samples, context.spread_kind());
+        result.stats.error = estimate_error(result.image, result.spread, sink.error_sums(),
+                                            sink.samples(), context.scene().settings.samples,
+                                            context.spread_kind(), context.rendered_pixels());
     } else {
         result.stats.error.unavailable = "the render is unfinished";
     }

@@ -196,6 +196,31 @@ TEST_F(MpiCli, TargetErrorGivesTheSingleProcesssBits) {
     EXPECT_EQ(r.out + r.err, "");
 }
 
+TEST_F(MpiCli, TargetErrorWithAPilotOfSomePixelsGivesTheSingleProcesssBits) {
+    // 128 x 128: the first round renders one pixel in 4 x 4 on every process's tiles; its estimate,
+    // assembled on the leader, sizes the full rounds.
+    const std::vector<std::string> goal{"--target-error", "0.01", "--stats", "s.json", "-q"};
+    ASSERT_EQ(run(small(kMotion, "one.pfm", goal, "128x128")).status, 0);
+    const std::string one = bytes("s.json");
+    EXPECT_NE(one.find("\"pilot_pixel_block\": 4"), std::string::npos) << one;
+    const Outcome r = run_mpi(3, small(kMotion, "three.pfm", goal, "128x128"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(bytes("three.pfm"), bytes("one.pfm"));
+    const auto rounds = [](const std::string& stats) {
+        return stats.substr(stats.find("\"rounds\""), stats.find("]}") - stats.find("\"rounds\""));
+    };
+    // The same rounds, their estimates included (their seconds differ).
+    const auto without_seconds = [&](std::string text) {
+        text = rounds(text);
+        for (std::size_t at; (at = text.find("\"seconds\": ")) != std::string::npos;) {
+            text.erase(at, text.find(',', at) + 1 - at);
+        }
+        return text;
+    };
+    EXPECT_EQ(without_seconds(bytes("s.json")), without_seconds(one));
+    EXPECT_EQ(r.out + r.err, "");
+}
+
 INSTANTIATE_TEST_SUITE_P(KProcessesByThreads, MpiProcessesAndThreads,
                          ::testing::Values(std::pair{1, 1}, std::pair{1, 2}, std::pair{2, 1},
                                            std::pair{2, 2}, std::pair{3, 1}, std::pair{3, 2}));
@@ -236,7 +261,7 @@ TEST_F(MpiCli, BatchRendersEveryScenesImageOnceWithTheHighestStatus) {
 
 TEST_F(MpiCli, StoppedUnderOneSplitResumedUnderAnotherGivesTheSameBits) {
     // 24 tiles: a stop after 2 or 6 leaves work, however many tiles are in hand elsewhere.
-    const std::string kSize = "96x64";
+    const std::string kSize = "128x128";
     const std::vector<std::string> more{"--spp", "8", "--checkpoint", "c.ckpt"};
     ASSERT_EQ(
         run(small(kMotion, "plain.pfm", {"--spp", "8", "--stats", "plain.json"}, kSize)).status, 0);

@@ -199,6 +199,17 @@ TEST(PredictedSeconds, ALineThroughTheLastTwoRoundsOrProportionalToOne) {
     EXPECT_DOUBLE_EQ(predicted_seconds({{10, 3.0, {}, {}}, {20, 2.0, {}, {}}}, 100), 10.0);
 }
 
+TEST(PredictedSeconds, CountsTheCameraSamplesTracedPerPixelCalibrationIncluded) {
+    // A pilot of 8 spp in one pixel of 16 that rendered all its pixels twice: 1 sample per pixel
+    // of the image in 1 s. Before a full round, a full round's calibration is not known.
+    const ProgressiveRound pilot{8, 1.0, {}, {}, 4, 1.0};
+    EXPECT_DOUBLE_EQ(predicted_seconds({pilot}, 10), 10.0);
+    // A full round of 10 spp with a tenth more for its calibration, 11 samples a pixel in 3 s:
+    // the line through both, 0.2 s a sample after 0.8 s, and that calibration share.
+    const ProgressiveRound full{10, 3.0, {}, {}, 1, 0.1};
+    EXPECT_DOUBLE_EQ(predicted_seconds({pilot, full}, 20), 0.8 + 0.2 * 20 * 1.1);
+}
+
 // ---- the command line --------------------------------------------------------------------------
 
 // Soft shadows and antialiasing; renders in milliseconds.
@@ -427,6 +438,132 @@ TEST_F(GoalCli, InfoPredictsTheSamplesAndTimeFromPilots) {
     EXPECT_EQ(bad.err,
               "drt info: --target-error: must be a finite positive number, got 0\n"
               "Run 'drt info --help' for usage.\n");
+}
+
+// ---- a pilot of some pixels
+// ----------------------------------------------------------------------
+
+TEST(PilotBlock, TheLargestSquareWithEnoughPilotPixelsUpToEight) {
+    EXPECT_EQ(kPilotPixels, 1024);
+    EXPECT_EQ(pilot_block(32, 24), 1);    // 768 pixels: all of them
+    EXPECT_EQ(pilot_block(80, 60), 1);    // squares of 2 would fit, but cost too much: all
+    EXPECT_EQ(pilot_block(127, 128), 1);  // squares of 3.99
+    EXPECT_EQ(pilot_block(128, 128), 4);  // 1,024 of 16,384 pixels
+    EXPECT_EQ(pilot_block(200, 150), 5);  // 1,200 of 30,000
+    EXPECT_EQ(pilot_block(400, 300), 8);  // squares of 10.8 held at 8: 1,875 of 120,000
+    EXPECT_EQ(pilot_block(1600, 1200), 8);
+}
+
+TEST(Predict, AfterAPilotOfSomePixelsAimsAt95PercentAlongMinusFourFifthsUp) {
+    // No image yet: the round alone must reach 0.95 E, from the pilot's error.
+    const ProgressiveRound pilot{8, 0.5, 0.02, std::nullopt, 4};
+    EXPECT_EQ(predict({pilot}, 0.01, 65536)->spp,
+              static_cast<int>(std::ceil(8 * std::pow(0.0095 / 0.02, -1 / 0.8))));  // 21
+    const ProgressiveRound low{8, 0.5, 0.005, std::nullopt, 4};
+    // Toward fewer samples along -3/4, as every smaller round: 8 x (0.0095 / 0.005)^(-4/3) = 3.4.
+    EXPECT_EQ(predict({low}, 0.01, 65536)->spp,
+              static_cast<int>(std::ceil(8 * std::pow(0.0095 / 0.005, -1 / 0.75))));
+    // A pilot's error under E is no image meeting E.
+    EXPECT_GT(next_round({low}, 0.01, 65536).spp, 0);
+    EXPECT_EQ(total_samples({pilot}), 0);
+}
+
+// kScene at 128 x 128: a pilot of one pixel in 4 x 4.
+LoadedScene pilot_scene() {
+    LoadedScene loaded = load_scene_from_string(kScene, "scene.xml");
+    loaded.scene.settings.width = 128;
+    loaded.scene.settings.height = 128;
+    return loaded;
+}
+
+TEST(RenderProgressively, APilotOfSomePixelsMeasuresTheImageAndIsNotKept) {
+    LoadedScene loaded = pilot_scene();
+    Scene& scene = loaded.scene;
+    ASSERT_EQ(pilot_block(128, 128), 4);
+    RenderJobOptions options;
+    options.threads = 2;
+    scene.settings.samples = 8;
+    const RenderResult eight = run_render_job(scene, options).render;
+    ASSERT_TRUE(eight.stats.error.rmse);
+    // A target three times the error of 8 spp: one full round of a few samples meets it.
+    ProgressiveGoal goal;
+    goal.target_error = 3 * *eight.stats.error.rmse;
+    goal.max_samples = 1000;
+    const ProgressiveResult p = render_progressively(scene, options, goal);
+    ASSERT_EQ(p.rounds.size(), 2u);
+    const ProgressiveRound& pilot = p.rounds[0];
+    EXPECT_EQ(pilot.spp, 8);
+    EXPECT_EQ(pilot.pixel_block, 4);
+    EXPECT_FALSE(pilot.full());
+    EXPECT_FALSE(pilot.combined);
+    // Its estimate is of the whole image's error per pixel: near the full render's (its 1,024
+    // pixels scatter; here 0.69 of it), not a quarter (its pixels' errors spread over all
+    // pixels) or four times it.
+    ASSERT_TRUE(pilot.error);
+    EXPECT_GT(*pilot.error, 0.5 * *eight.stats.error.rmse);
+    EXPECT_LT(*pilot.error, 2.0 * *eight.stats.error.rmse);
+    // Its cost: 8 samples in one pixel of 16, and about half of its 1,024 pixels rendered twice
+    // for the calibration (512 pixels, kMinSmallImageCalibration).
+    EXPECT_NEAR(pilot.calibration, 0.5, 0.1);
+    EXPECT_DOUBLE_EQ(pilot.cost(), 0.5 * (1 + pilot.calibration));
+    // The one full round is the plain render of its count and the scene's seed, bit for bit;
+    // the image's samples are its own.
+    const ProgressiveRound& full = p.rounds[1];
+    EXPECT_TRUE(full.full());
+    EXPECT_LT(full.spp, 8);
+    EXPECT_TRUE(p.target_met);
+    EXPECT_EQ(p.samples, full.spp);
+    scene.settings.samples = full.spp;
+    const RenderResult plain = run_render_job(scene, options).render;
+    EXPECT_EQ(p.job.render.image.rgb, plain.image.rgb);
+    // Its estimate, recomputed as the rounds' combination, agrees to rounding.
+    ASSERT_TRUE(p.error && plain.stats.error.rmse);
+    EXPECT_NEAR(*p.error, *plain.stats.error.rmse, 1e-6 * *p.error);
+    EXPECT_EQ(p.job.render.stats.samples, plain.stats.samples);
+}
+
+TEST_F(GoalCli, APilotOfSomePixelsThenOneRoundIsThePlainRenderOfItsCount) {
+    const std::vector<std::string> size{"--width", "128", "--height", "128"};
+    std::vector<std::string> goal{"scene.xml", "--target-error", "0.03",  "-o",
+                                  "goal.pfm",  "--stats",        "s.json"};
+    goal.insert(goal.end(), size.begin(), size.end());
+    const Outcome r = run(goal);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto rounds = regex_groups(
+        r.err, ": ([0-9]+) spp after a pilot of 8 spp on 1 pixel in 16, rounds of ([0-9]+) spp;");
+    ASSERT_EQ(rounds.size(), 3u) << r.err;
+    EXPECT_EQ(rounds[1], rounds[2]);
+    EXPECT_EQ(reached(r.err), std::stoi(rounds[1])) << r.err;
+    EXPECT_NE(bytes("s.json").find("{\"spp\": 8, \"pilot_pixel_block\": 4, \"seconds\": "),
+              std::string::npos)
+        << bytes("s.json");
+    EXPECT_NE(bytes("s.json").find("{\"spp\": " + rounds[1] + ", \"seed\": \"3\", "),
+              std::string::npos)
+        << bytes("s.json");
+    std::vector<std::string> plain{"scene.xml", "--spp", rounds[1], "-o", "plain.pfm", "-q"};
+    plain.insert(plain.end(), size.begin(), size.end());
+    ASSERT_EQ(run(plain).status, 0);
+    EXPECT_EQ(bytes("goal.pfm"), bytes("plain.pfm"));
+}
+
+TEST_F(GoalCli, TargetErrorWithAPilotGivesTheSameBitsForAnyThreadCount) {
+    // A target that takes two full rounds after the pilot (18 and 25 spp).
+    std::vector<std::string> images;
+    std::string summary;
+    for (const std::string threads : {"1", "2", "3"}) {
+        const Outcome r = run({"scene.xml", "--target-error", "0.003", "--width", "128", "--height",
+                               "128", "-o", "t" + threads + ".pfm", "--threads", threads});
+        ASSERT_EQ(r.status, 0) << r.err;
+        const auto line = regex_groups(r.err,
+                                       "(after a pilot of 8 spp on 1 pixel in 16, rounds of "
+                                       "[0-9]+(, [0-9]+)+ spp)");
+        ASSERT_EQ(line.size(), 3u) << r.err;
+        if (summary.empty()) summary = line[1];
+        EXPECT_EQ(line[1], summary);
+        images.push_back(bytes("t" + threads + ".pfm"));
+    }
+    EXPECT_EQ(images[0], images[1]);
+    EXPECT_EQ(images[0], images[2]);
 }
 
 }  // namespace

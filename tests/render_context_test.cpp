@@ -103,5 +103,67 @@ TEST(RenderContext, WithoutTheEstimateRendersTheSamePixelsAndNoneTwice) {
     EXPECT_GE(calibrated.pixels, 64);  // 8 % of 9,216 pixels rendered twice on average
 }
 
+TEST(RenderContext, APixelBlockRendersOnePixelOfEachSquareAsTheFullRenderDoes) {
+    // 90 x 90 in squares of 4: 22 x 22 whole squares and a row and a column of squares that the
+    // image's edge cuts to 2 pixels across.
+    Scene scene = testing::scaled_scene("thesis/test1.xml", 90, 4);
+    scene.settings.height = 90;
+    const RenderContext full(scene, std::nullopt);
+    const RenderContext pilot(scene, std::nullopt, true, 4);
+    std::uint64_t picked = 0, in_cut_squares = 0;
+    for (int sy = 0; sy < 90; sy += 4) {
+        for (int sx = 0; sx < 90; sx += 4) {
+            int in_square = 0;
+            for (int y = sy; y < std::min(sy + 4, 90); ++y) {
+                for (int x = sx; x < std::min(sx + 4, 90); ++x) in_square += pilot.renders(x, y);
+            }
+            // One in a whole square; at most one in a cut square, whose place may lie outside
+            // the image, so that every pixel has the same odds.
+            if (sx + 4 <= 90 && sy + 4 <= 90) {
+                EXPECT_EQ(in_square, 1) << sx << " " << sy;
+            } else {
+                EXPECT_LE(in_square, 1) << sx << " " << sy;
+                in_cut_squares += static_cast<std::uint64_t>(in_square);
+            }
+            picked += static_cast<std::uint64_t>(in_square);
+        }
+    }
+    EXPECT_EQ(pilot.rendered_pixels(), picked);
+    EXPECT_EQ(full.rendered_pixels(), 8100u);
+    // 45 cut squares hold 8 (or 4) of their 16 places inside: about 22 picked; 1 in 16 each
+    // would make at least 3 and at most 43 all but impossible.
+    EXPECT_GE(in_cut_squares, 3u);
+    EXPECT_LE(in_cut_squares, 43u);
+    // Another seed picks other places: the same as this one's in about 1 square in 16.
+    Scene reseeded = testing::scaled_scene("thesis/test1.xml", 90, 4);
+    reseeded.settings.height = 90;
+    reseeded.settings.seed = scene.settings.seed + 1;
+    const RenderContext other(reseeded, std::nullopt, true, 4);
+    int same = 0;
+    for (int y = 0; y < 88; ++y) {
+        for (int x = 0; x < 88; ++x) same += pilot.renders(x, y) && other.renders(x, y);
+    }
+    EXPECT_LT(same, 484 / 4);
+    // A picked pixel has the full render's bits and takes the tile's only samples; the others
+    // are 0 with no spread.
+    std::uint64_t samples = 0;
+    for (const Tile& tile : full.tiles()) {
+        const TileBuffer a = full.render_tile(tile);
+        const TileBuffer b = pilot.render_tile(tile);
+        samples += b.samples;
+        for (int y = tile.y0; y < tile.y1; ++y) {
+            for (int x = tile.x0; x < tile.x1; ++x) {
+                const int tx = x - tile.x0, ty = y - tile.y0;
+                const bool rendered = pilot.renders(x, y);
+                EXPECT_EQ(b.pixels.at(tx, ty), rendered ? a.pixels.at(tx, ty) : Color{})
+                    << x << " " << y;
+                EXPECT_EQ(b.spread.at(tx, ty), rendered ? a.spread.at(tx, ty) : Color{})
+                    << x << " " << y;
+            }
+        }
+    }
+    EXPECT_EQ(samples, 4 * picked);
+}
+
 }  // namespace
 }  // namespace drt

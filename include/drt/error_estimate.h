@@ -126,10 +126,12 @@ struct ErrorEstimate {
 // spreads (the same size), the image's sums and its camera `samples`. relMSE stands x^2 -
 // variance (at least 0) for the unknown ref^2. `spp` is the samples per pixel asked for: with 1
 // the pixel centre is taken and nothing can be estimated. Where no sample of any pixel spread and
-// no pixel rendered twice differed, the estimate is 0 however few were rendered twice. Throws
-// ImageError when the sizes differ.
+// no pixel rendered twice differed, the estimate is 0 however few were rendered twice. `pixels`
+// is how many pixels were rendered, the others left 0 (a pilot's, render_context.h): the mean is
+// theirs; 0 for all. Throws ImageError when the sizes differ.
 ErrorEstimate estimate_error(const Image& image, const Image& spread, const ErrorSums& sums,
-                             std::uint64_t samples, int spp, SpreadKind kind);
+                             std::uint64_t samples, int spp, SpreadKind kind,
+                             std::uint64_t pixels = 0);
 
 // The per-pixel standard error, per channel: sqrt(spread x scale); 0 where there is no estimate.
 Image standard_error_image(const Image& spread, const ErrorEstimate& estimate);

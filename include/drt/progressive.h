@@ -8,8 +8,12 @@
 // variances times their weights squared, which is what the combined estimate states, pixel by
 // pixel. The counts are chosen on the leader from the rounds' estimated errors and shared with
 // every process, so the same command gives the same bits for any --threads and any number of
-// processes. The first round is the plain render `--spp 8`; the image as a whole is no plain
-// render's (a stratified pattern of N samples does not extend one of fewer).
+// processes. On an image of at least 16 x kPilotPixels pixels the first round is a pilot of one
+// pixel in b x b (pilot_block) at kFirstPilot samples, which measures the image's error per
+// pixel for a b^2-th of a full round's cost and is then dropped; on a smaller one it is the full
+// render `--spp 8`, kept. The first full round is the plain render `--spp N` of its count; where
+// it meets the target alone, the image is that render's bit for bit. Otherwise the image is no
+// plain render's (a stratified pattern of N samples does not extend one of fewer).
 //
 // To a time limit alone, each round is a complete render at one sample count that replaces the
 // last, so the image kept is bit-identical to the plain render `--spp N` of the count N it
@@ -42,13 +46,38 @@ struct ProgressiveRound {
     double seconds = 0;           // its wall-clock time
     std::optional<double> error;  // its own estimated RMSE; absent where it cannot be estimated
     // The estimated RMSE of the image kept after it: of the rounds so far combined (a target
-    // error), or its own (a time limit alone).
+    // error), or its own (a time limit alone); absent after a pilot of some pixels.
     std::optional<double> combined;
+    // Above 1: a pilot that rendered one pixel in pixel_block x pixel_block and is not part of
+    // the image (its error still stands for the whole image's at its count).
+    int pixel_block = 1;
+    // The camera samples its error estimate's calibration traced, over its own (a pilot of some
+    // pixels renders a larger share of them twice than a full round).
+    double calibration = 0;
+
+    bool full() const { return pixel_block == 1; }
+    // The camera samples it traced per pixel of the image, its calibration's included: what its
+    // time paid for.
+    double cost() const { return spp / double(pixel_block * pixel_block) * (1 + calibration); }
 };
 
-// The seed of round `round` (from 0) of a render to a target error: the scene's for the first, so
-// that the pilot is the plain render of its count, and a hash of it for the others, whose
-// patterns are then independent of the first's and of every plain render's with a nearby seed.
+// A pilot takes at least this many pixels, so that its error estimate stands for the image's.
+inline constexpr double kPilotPixels = 1024;
+// A pilot of some pixels takes at most one pixel in kMinPilotBlock squared: a costlier one, not
+// kept, loses more than a full pilot, kept, does (at --scale 0.1, 80 x 60, one pixel in 2 x 2
+// made the thesis scenes' goal renders 4 % dearer, docs/accuracy.md section 6).
+inline constexpr int kMinPilotBlock = 4;
+// And at least one in kMaxPilotBlock squared: beyond, it costs too little to matter.
+inline constexpr int kMaxPilotBlock = 8;
+// The side b of the squares of which a render to a target error pilots one pixel: the largest
+// with at least kPilotPixels squares, at most kMaxPilotBlock; 1 (a full pilot, kept) where that
+// is under kMinPilotBlock, below 16 x kPilotPixels pixels (128 x 128).
+int pilot_block(int width, int height);
+
+// The seed of full round `round` (from 0; a pilot of some pixels has the scene's seed and is not
+// counted) of a render to a target error: the scene's for the first, so that it is the plain
+// render of its count, and a hash of it for the others, whose patterns are then independent of
+// the first's and of every plain render's with a nearby seed.
 std::uint64_t round_seed(std::uint64_t seed, std::size_t round);
 
 // A round's weight in the combined image: the inverse of its estimated variance, 1 / error^2,
@@ -58,7 +87,7 @@ std::uint64_t round_seed(std::uint64_t seed, std::size_t round);
 // rounds have none, the image is still the mean of their samples).
 double round_weight(const std::optional<double>& error, int spp);
 
-// The samples per pixel of all rounds together.
+// The samples per pixel of all full rounds together: the image's.
 int total_samples(const std::vector<ProgressiveRound>& rounds);
 
 // Samples per pixel and time a render needs to reach an error, extrapolated from rounds.
@@ -78,13 +107,16 @@ struct Prediction {
 // instead, whatever the measured slope: between 2 and 8 spp the thesis scenes' stratified errors
 // fall along -0.6 to -0.83, and a pattern's gain over independent samples is smallest at few
 // samples. With round_weight's weights the combined error c' of one more round of error e is
-// 1 / c'^2 = 1 / c^2 + 1 / e^2, c the rounds' combined estimate so far. At least 2 samples.
-// Absent when no round has a positive estimate or the last has no combined one.
+// 1 / c'^2 = 1 / c^2 + 1 / e^2, c the rounds' combined estimate so far. After a pilot of some
+// pixels alone, e itself, reaching a 0.95 share of the target, and toward more samples than the
+// pilot's along -0.8 (progressive.cpp, kPilotSpareShare). At least 2 samples. Absent when no
+// round has a positive estimate or the last full round has no combined one.
 std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, double target,
                                   int max_samples, double steepest = -1.0);
 
-// Seconds a render of `spp` samples takes, from a line (set-up plus a cost per sample) through
-// the last two rounds' times; from the last round alone when there is one.
+// Seconds a full render of `spp` samples takes, from a line (set-up plus a cost per camera sample
+// traced per pixel) through the last two rounds' times and costs (from the last round alone when
+// there is one), with the last full round's share of calibration (none before one).
 double predicted_seconds(const std::vector<ProgressiveRound>& rounds, int spp);
 
 // The count of the round after `rounds` on the way to `target` (with all rounds at most

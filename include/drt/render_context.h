@@ -34,8 +34,11 @@ class RenderContext {
   public:
     // Throws std::invalid_argument for an unknown sampler name. `estimate_error` false skips the
     // error estimate's calibration (its second renders), for a render whose estimate nobody reads.
+    // `pixel_block` above 1 renders one pixel of each pixel_block x pixel_block square of the
+    // image (see renders()) and leaves the others 0: a pilot that measures the whole image's
+    // error per pixel at a fraction of its cost (progressive.h).
     RenderContext(const Scene& scene, std::optional<AdaptiveSampling> adaptive,
-                  bool estimate_error = true);
+                  bool estimate_error = true, int pixel_block = 1);
     // The integrator refers to the sampler, plan and BVH held here: the context stays put.
     RenderContext(const RenderContext&) = delete;
     RenderContext& operator=(const RenderContext&) = delete;
@@ -49,6 +52,15 @@ class RenderContext {
 
     // How the sampler's samples tell their error (error_estimate.h).
     SpreadKind spread_kind() const;
+
+    // Whether pixel (x, y) is rendered: every pixel, or with a pixel block of b, the one pixel of
+    // its b x b square (squares aligned to the image's corner) that a hash of the seed and the
+    // square picks among b x b places; a square cut by the image's edge may then have none, so
+    // that every pixel has the same odds, 1 / b^2, and the rendered pixels' mean error is an
+    // unbiased guess at the image's.
+    bool renders(int x, int y) const;
+    // How many pixels renders() picks.
+    std::uint64_t rendered_pixels() const { return rendered_pixels_; }
 
     // Renders every pixel of `tile`. Safe to call from several threads at once.
     TileBuffer render_tile(const Tile& tile) const;
@@ -99,6 +111,8 @@ class RenderContext {
     Integrator integrator_;
     std::optional<AdaptiveSampling> adaptive_;
     bool estimate_error_;
+    int pixel_block_;
+    std::uint64_t rendered_pixels_ = 0;
     std::vector<Tile> tiles_;
 };
 

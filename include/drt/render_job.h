@@ -36,6 +36,10 @@ struct RenderJobOptions {
     // of the camera samples, render_context.h). A checkpoint keeps the estimate's sums, so a
     // render with one always estimates.
     bool estimate_error = true;
+    // Above 1: one pixel of each pixel_block x pixel_block square is rendered, the others left 0
+    // (RenderContext): a render to a target error's pilot (progressive.h), which keeps no
+    // checkpoint (the checkpoint's fingerprint does not know this).
+    int pixel_block = 1;
     std::stop_token stop;
     const MpiJob* mpi = nullptr;  // absent: one process
 };
