@@ -63,9 +63,15 @@ struct Line {
 };
 
 // Seconds against samples per image pixel through the last two rounds; set-up and a cost per
-// sample, neither negative, so a noisy pair of times never predicts a free sample.
+// sample, neither negative, so a noisy pair of times never predicts a free sample. After a pilot
+// of some pixels, its own set-up and the rest of its time: at 400 x 300 the set-up is 40 % of its
+// time, and taken as samples it made a full round's time 1.7 times too long.
 Line time_line(const std::vector<ProgressiveRound>& rounds) {
     const ProgressiveRound& last = rounds.back();
+    if (!last.full()) {
+        const double setup = std::clamp(last.setup_seconds, 0.0, last.seconds);
+        return {setup, (last.seconds - setup) / last.cost()};
+    }
     Line line{0, last.seconds / last.cost()};
     if (rounds.size() < 2) return line;
     const ProgressiveRound& before = rounds[rounds.size() - 2];
@@ -310,9 +316,10 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
             out.stopped = options.stop.stop_requested();
             if (full_rounds == 0) out.job = std::move(job);
         } else {
+            const RenderStats& stats = job.render.stats;
             ProgressiveRound done{
-                spp,   job.render.stats.seconds,   estimated_error(job.render), std::nullopt,
-                block, job.render.stats.error.cost};
+                spp,   stats.seconds,    estimated_error(job.render), std::nullopt,
+                block, stats.error.cost, stats.setup_seconds};
             // A pilot of some pixels is measured, not kept.
             if (done.full()) {
                 if (out.combined) {

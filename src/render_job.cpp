@@ -99,6 +99,7 @@ RenderJobResult run_render_job(const Scene& scene, const RenderJobOptions& optio
         todo = costly_first(context, std::move(todo),
                             threads * (options.mpi ? options.mpi->size() : 1), threads);
     }
+    const auto tiles_start = std::chrono::steady_clock::now();
     MpiShare share;
     if (options.mpi) {
         // Elsewhere than on the leader, tiles go to the leader instead of a sink.
@@ -127,6 +128,8 @@ RenderJobResult run_render_job(const Scene& scene, const RenderJobOptions& optio
     stats.processes = options.mpi ? options.mpi->size() : 1;
     if (kept && !out.complete()) kept->write();
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats.setup_seconds =
+        stats.seconds - std::chrono::duration<double>(finished - tiles_start).count();
     return out;
 }
 

@@ -204,6 +204,9 @@ TEST(PredictedSeconds, CountsTheCameraSamplesTracedPerPixelCalibrationIncluded) 
     // of the image in 1 s. Before a full round, a full round's calibration is not known.
     const ProgressiveRound pilot{8, 1.0, {}, {}, 4, 1.0};
     EXPECT_DOUBLE_EQ(predicted_seconds({pilot}, 10), 10.0);
+    // Its set-up (before and after its tiles) is paid once, not per sample.
+    const ProgressiveRound set_up{8, 1.0, {}, {}, 4, 1.0, 0.2};
+    EXPECT_DOUBLE_EQ(predicted_seconds({set_up}, 10), 0.2 + 0.8 * 10);
     // A full round of 10 spp with a tenth more for its calibration, 11 samples a pixel in 3 s:
     // the line through both, 0.2 s a sample after 0.8 s, and that calibration share.
     const ProgressiveRound full{10, 3.0, {}, {}, 1, 0.1};

@@ -110,7 +110,9 @@ for name in $scenes; do
             fixed_s=$(echo $fixed_times | median)
         fi
         goal_spp=$(json samples_per_pixel "$tmp/goal.json")
-        rounds=$(grep -o '"spp": [0-9]*' "$tmp/goal.json" | sed 's/"spp": //' | paste -sd' ')
+        # A pilot of one pixel in b x b counts as spp/(b*b) samples per pixel of the image.
+        rounds=$(grep -o '{"spp": [0-9]*\(, "pilot_pixel_block": [0-9]*\)\?' "$tmp/goal.json" |
+            sed -e 's/{"spp": //' -e 's/, "pilot_pixel_block": \([0-9]*\)/\/(\1*\1)/' | paste -sd' ')
         estimated=$(json estimated_rmse "$tmp/goal.json")
         goal_true=$("$drt" compare "$tmp/goal.pfm" "$ref" | sed 's/rmse=\([^ ]*\).*/\1/')
         echo "$name,$target,$predicted,$goal_spp,$rounds,$goal_s,$(json seconds "$tmp/goal.json"),$estimated,$goal_true,$fixed,$fixed_s,$(json seconds "$tmp/fixed.json"),$(rmse_at "$fixed"),$(cut -d' ' -f1 /proc/loadavg)" >>"$csv"
@@ -119,11 +121,12 @@ for name in $scenes; do
 done
 
 # "goal samples / fixed": every round's samples against the fixed count's (free of the machine's
-# noise); "load" the 1-minute load average when the case was timed.
+# noise; a pilot of one pixel in b x b, shown as 8/(b*b), counts its share); "load" the 1-minute
+# load average when the case was timed.
 echo "| scene | E | predicted spp | predicted s | goal rounds (spp) | goal s | goal estimated RMSE | goal true RMSE | true / E | cheapest fixed spp (true RMSE ≤ E) | its s | goal samples / fixed | goal s / fixed s | load |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 tail -n +2 "$csv" | while IFS=, read -r name target pspp ps gspp rounds gs grs gest gtrue fspp fs frs ftrue load; do
-    samples=$(echo "${rounds// /+}" | bc)
+    samples=$(echo "scale=3; ${rounds// /+}" | bc)
     walls=nan
     [ "$gs" = nan ] || walls=$(echo "$gs / $fs" | bc -l)
     printf '| %s | %s | %s | %.2f | %s | %.2f | %.5f | %.5f | %.2f | %s | %.2f | %.2f | %.2f | %s |\n' \

@@ -54,6 +54,8 @@ struct ProgressiveRound {
     // The camera samples its error estimate's calibration traced, over its own (a pilot of some
     // pixels renders a larger share of them twice than a full round).
     double calibration = 0;
+    // Of `seconds`, what went before and after its tiles (RenderStats::setup_seconds).
+    double setup_seconds = 0;
 
     bool full() const { return pixel_block == 1; }
     // The camera samples it traced per pixel of the image, its calibration's included: what its

@@ -32,6 +32,9 @@ struct RenderOptions {
 
 struct RenderStats {
     double seconds = 0;
+    // Of those, what went before and after rendering the tiles (building the context, ordering
+    // the tiles, assembling the image). Set by run_render_job (render_job.h).
+    double setup_seconds = 0;
     int threads = 1;    // worker threads of one process
     int processes = 1;  // processes of an MPI job (mpi_work.h)
     // From the last tile handed out to the last one finished: the tail, when workers run out of
