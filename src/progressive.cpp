@@ -35,11 +35,12 @@ constexpr double kIndependentSlope = -0.5;
 constexpr double kSmallRoundSlope = -0.75;
 // The first full round after a pilot of some pixels aims at this share of the target, and toward
 // more samples than the pilot's along kPilotSlope (toward fewer along kSmallRoundSlope, as any
-// smaller round): the pilot's estimate scatters more than a full round's (0.8-1.4 of the image's
-// on the thesis scenes at --scale 0.25, 1,200 pixels), and a full round that falls short is
-// topped up by a second pattern, whose split costs the steep scenes 20-50 % where the margin
-// costs about 6 %; -0.8 lies among the thesis scenes' stratified slopes above 8 spp. Measured
-// against other shares, slopes and pilot sizes in docs/accuracy.md, section 6.
+// smaller round): the pilot's estimate scatters more than a full round's (0.64-1.29 of the true
+// RMSE on Test1 and Test5 at --scale 0.25 with 1,200 pixels, the full render's own 0.86-1.12),
+// and a full round that falls short is topped up by a second pattern, whose split costs the
+// steep scenes 20-50 % where the margin costs about 6 %; -0.8 lies among the thesis scenes'
+// stratified slopes above 8 spp. Measured against other shares, slopes and pilot sizes in
+// docs/accuracy.md, section 6.
 constexpr double kPilotSpareShare = 0.95;
 constexpr double kPilotSlope = -0.8;
 // Of the time left, what a round may be predicted to take: the rest absorbs the prediction's
@@ -64,8 +65,8 @@ struct Line {
 
 // Seconds against samples per image pixel through the last two rounds; set-up and a cost per
 // sample, neither negative, so a noisy pair of times never predicts a free sample. After a pilot
-// of some pixels, its own set-up and the rest of its time: at 400 x 300 the set-up is 40 % of its
-// time, and taken as samples it made a full round's time 1.7 times too long.
+// of some pixels, its own set-up and the rest of its time: at 400 x 300 its set-up is a quarter
+// of its time, and counted as samples it predicted 1.6 times a full round's time.
 Line time_line(const std::vector<ProgressiveRound>& rounds) {
     const ProgressiveRound& last = rounds.back();
     if (!last.full()) {
