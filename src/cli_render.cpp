@@ -330,6 +330,9 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
         if (checkpoint) {
             err << " and " << printable(checkpoint->string())
                 << "\ndrt: run the same command again to resume\n";
+        } else if (job.goal.wanted()) {
+            // A goal's rounds keep no checkpoint (--checkpoint excludes them): no hint to one.
+            err << " (the goal's first round; a goal render cannot be resumed)\n";
         } else {
             err << "\ndrt: with --checkpoint FILE an interrupted render can be resumed\n";
         }

@@ -549,6 +549,25 @@ TEST_F(GoalCli, APilotOfSomePixelsThenOneRoundIsThePlainRenderOfItsCount) {
     EXPECT_EQ(bytes("goal.pfm"), bytes("plain.pfm"));
 }
 
+TEST_F(GoalCli, AGoalStoppedInItsFirstRoundKeepsItsTilesAndPointsToNoCheckpoint) {
+    // With a pilot of some pixels (128 x 128) and without: the first round's finished tiles.
+    for (const std::string side : {"24", "128"}) {
+        const Outcome r = run({"scene.xml", "--target-error", "0.01", "--width", side, "--height",
+                               side, "--stop-after-tiles", "1", "-o", "s.pfm"});
+        EXPECT_EQ(r.status, 130) << r.err;
+        EXPECT_NE(r.err.find(": interrupted with 1 of "), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find(" tiles done; wrote s.partial.pfm (the goal's first round; a goal "
+                             "render cannot be resumed)\n"),
+                  std::string::npos)
+            << r.err;
+        // --checkpoint excludes a goal: no hint to it.
+        EXPECT_EQ(r.err.find("--checkpoint"), std::string::npos) << r.err;
+        EXPECT_FALSE(fs::exists(dir_ / "s.pfm"));
+        EXPECT_TRUE(fs::exists(dir_ / "s.partial.pfm"));
+        fs::remove(dir_ / "s.partial.pfm");
+    }
+}
+
 TEST_F(GoalCli, TargetErrorWithAPilotGivesTheSameBitsForAnyThreadCount) {
     // A target that takes two full rounds after the pilot (18 and 25 spp).
     std::vector<std::string> images;
