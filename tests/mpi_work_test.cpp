@@ -132,9 +132,17 @@ class MpiCli : public ::testing::Test {
         dir_ = fs::temp_directory_path() / ("drt_mpi_test_" + std::to_string(getpid()) + name);
         fs::remove_all(dir_);
         fs::create_directories(dir_);
+        // Each test's mpirun keeps its session files apart: two mpiruns starting at once (ctest
+        // -j2) raced to create the shared /tmp/ompi.HOST.UID and one failed ("File exists").
+        // A short path: Open MPI's sockets live under it.
+        session_ = fs::temp_directory_path() / ("drt-ompi-" + std::to_string(getpid()));
+        fs::remove_all(session_);
+        fs::create_directories(session_);
+        setenv("OMPI_MCA_orte_tmpdir_base", session_.c_str(), 1);
     }
     void TearDown() override {
         if (!HasFailure()) fs::remove_all(dir_);
+        fs::remove_all(session_);
     }
     std::vector<std::string> mpirun(int processes, const std::vector<std::string>& args) const {
         std::vector<std::string> argv{"mpirun", "--allow-run-as-root",     "--oversubscribe",
@@ -149,6 +157,7 @@ class MpiCli : public ::testing::Test {
     std::string bytes(const std::string& name) const { return read_bytes(dir_ / name); }
 
     fs::path dir_;
+    fs::path session_;
 };
 
 // A small render of `scene` into `output` with the given extra options.
