@@ -68,22 +68,33 @@ RenderContext::RenderContext(const Scene& scene, std::optional<AdaptiveSampling>
     if (adaptive_) {
         adaptive_->min_samples = std::clamp(adaptive_->min_samples, 1, scene.settings.samples);
     }
-    for (int y = 0; y < scene.settings.height; ++y) {
-        for (int x = 0; x < scene.settings.width; ++x) rendered_pixels_ += renders(x, y) ? 1 : 0;
+    // A plain render (block 1) counts every pixel at once; a pilot takes one hash a square.
+    const auto width = static_cast<std::uint64_t>(scene.settings.width);
+    const auto height = static_cast<std::uint64_t>(scene.settings.height);
+    const auto b = static_cast<std::uint64_t>(pixel_block_);
+    if (b == 1) rendered_pixels_ = width * height;
+    for (std::uint64_t sy = 0; b > 1 && sy * b < height; ++sy) {
+        for (std::uint64_t sx = 0; sx * b < width; ++sx) {
+            const std::uint64_t place = picked_place(sx, sy);
+            rendered_pixels_ += sx * b + place % b < width && sy * b + place / b < height ? 1 : 0;
+        }
     }
 }
 
 // Keeps the pilot's choice of pixels apart from other hashes of the seed.
 constexpr std::uint64_t kPixelBlockStream = 0x706c6f74ULL;
 
+std::uint64_t RenderContext::picked_place(std::uint64_t sx, std::uint64_t sy) const {
+    if (pixel_block_ == 1) return 0;
+    const auto b = static_cast<std::uint64_t>(pixel_block_);
+    return hash_of(scene_.settings.seed, kPixelBlockStream, sx, sy) % (b * b);
+}
+
 bool RenderContext::renders(int x, int y) const {
     if (pixel_block_ == 1) return true;
     const auto b = static_cast<std::uint64_t>(pixel_block_);
-    const std::uint64_t place =
-        hash_of(scene_.settings.seed, kPixelBlockStream, static_cast<std::uint64_t>(x) / b,
-                static_cast<std::uint64_t>(y) / b) %
-        (b * b);
-    return place == (static_cast<std::uint64_t>(y) % b) * b + static_cast<std::uint64_t>(x) % b;
+    const auto ux = static_cast<std::uint64_t>(x), uy = static_cast<std::uint64_t>(y);
+    return picked_place(ux / b, uy / b) == (uy % b) * b + ux % b;
 }
 
 SpreadKind RenderContext::spread_kind() const {

@@ -74,6 +74,10 @@ class RenderContext {
     std::uint64_t estimate_cost(const Tile& tile) const;
 
   private:
+    // With a pixel block of b, the place (y % b) * b + x % b of the pixel that renders() picks in
+    // square (sx, sy), counted from the square's corner.
+    std::uint64_t picked_place(std::uint64_t sx, std::uint64_t sy) const;
+
     // What one pixel's render leaves: its value, the spread of its samples, the camera samples it
     // took, whether adaptive sampling stopped it early.
     struct Pixel {
