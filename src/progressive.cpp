@@ -35,12 +35,12 @@ constexpr double kIndependentSlope = -0.5;
 constexpr double kSmallRoundSlope = -0.75;
 // The first full round after a pilot of some pixels aims at this share of the target, and toward
 // more samples than the pilot's along kPilotSlope (toward fewer along kSmallRoundSlope, as any
-// smaller round): the pilot's estimate scatters more than a full round's (0.64-1.29 of the true
-// RMSE on Test1 and Test5 at --scale 0.25 with 1,200 pixels, the full render's own 0.86-1.12),
-// and a full round that falls short is topped up by a second pattern, whose split costs the
-// steep scenes 20-50 % where the margin costs about 6 %; -0.8 lies among the thesis scenes'
-// stratified slopes above 8 spp. Measured against other shares, slopes and pilot sizes in
-// docs/accuracy.md, section 6.
+// smaller round): the pilot's estimate scatters a little more than a full round's (0.82-1.14 of
+// the true RMSE on Test2, Test4 and Test5 at --scale 0.25 with 1,200 pixels and 20 seeds, the
+// full render's own 0.86-1.12), and a full round that falls short is topped up by a second
+// pattern, whose split costs the steep scenes 20-50 % where the margin costs about 6 %; -0.8
+// lies among the thesis scenes' stratified slopes above 8 spp. Measured against other shares,
+// slopes and pilot sizes in docs/accuracy.md, section 6.
 constexpr double kPilotSpareShare = 0.95;
 constexpr double kPilotSlope = -0.8;
 // Of the time left, what a round may be predicted to take: the rest absorbs the prediction's

@@ -500,15 +500,15 @@ TEST(RenderProgressively, APilotOfSomePixelsMeasuresTheImageAndIsNotKept) {
     EXPECT_FALSE(pilot.full());
     EXPECT_FALSE(pilot.combined);
     // Its estimate is of the whole image's error per pixel: near the full render's (its 1,024
-    // pixels scatter; here 0.69 of it), not a quarter (its pixels' errors spread over all
+    // pixels scatter; here 0.71 of it), not a quarter (its pixels' errors spread over all
     // pixels) or four times it.
     ASSERT_TRUE(pilot.error);
     EXPECT_GT(*pilot.error, 0.5 * *eight.stats.error.rmse);
     EXPECT_LT(*pilot.error, 2.0 * *eight.stats.error.rmse);
-    // Its cost: 8 samples in one pixel of 16, and about half of its 1,024 pixels rendered twice
-    // for the calibration (512 pixels, kMinSmallImageCalibration).
-    EXPECT_NEAR(pilot.calibration, 0.5, 0.1);
-    EXPECT_DOUBLE_EQ(pilot.cost(), 0.5 * (1 + pilot.calibration));
+    // Its cost: 8 samples in one pixel of 16, each of its 1,024 pixels rendered twice for its
+    // estimate.
+    EXPECT_DOUBLE_EQ(pilot.calibration, 1.0);
+    EXPECT_DOUBLE_EQ(pilot.cost(), 1.0);
     // The one full round is the plain render of its count and the scene's seed, bit for bit;
     // the image's samples are its own.
     const ProgressiveRound& full = p.rounds[1];

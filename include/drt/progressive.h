@@ -51,8 +51,8 @@ struct ProgressiveRound {
     // Above 1: a pilot that rendered one pixel in pixel_block x pixel_block and is not part of
     // the image (its error still stands for the whole image's at its count).
     int pixel_block = 1;
-    // The camera samples its error estimate's calibration traced, over its own (a pilot of some
-    // pixels renders a larger share of them twice than a full round).
+    // The camera samples its error estimate's calibration traced, over its own (1 for a pilot of
+    // some pixels, which renders each of its pixels twice).
     double calibration = 0;
     // Of `seconds`, what went before and after its tiles (RenderStats::setup_seconds).
     double setup_seconds = 0;
