@@ -9,11 +9,12 @@
 // pixel. The counts are chosen on the leader from the rounds' estimated errors and shared with
 // every process, so the same command gives the same bits for any --threads and any number of
 // processes. On an image of at least 16 x kPilotPixels pixels the first round is a pilot of one
-// pixel in b x b (pilot_block) at kFirstPilot samples, which measures the image's error per
-// pixel for a b^2-th of a full round's cost and is then dropped; on a smaller one it is the full
-// render `--spp 8`, kept. The first full round is the plain render `--spp N` of its count; where
-// it meets the target alone, the image is that render's bit for bit. Otherwise the image is no
-// plain render's (a stratified pattern of N samples does not extend one of fewer).
+// pixel in b x b (pilot_block) at kFirstPilot samples, each rendered twice, which measures the
+// image's error per pixel for 2 / b^2 of a full round's cost and is then dropped; on a smaller
+// one it is the full render `--spp 8`, kept. The first full round is the plain render `--spp N`
+// of its count; where it meets the target alone, the image is that render's bit for bit.
+// Otherwise the image is no plain render's (a stratified pattern of N samples does not extend
+// one of fewer).
 //
 // To a time limit alone, each round is a complete render at one sample count that replaces the
 // last, so the image kept is bit-identical to the plain render `--spp N` of the count N it
