@@ -446,15 +446,16 @@ TEST_F(GoalCli, InfoPredictsTheSamplesAndTimeFromPilots) {
 // ---- a pilot of some pixels
 // ----------------------------------------------------------------------
 
-TEST(PilotBlock, TheLargestSquareWithEnoughPilotPixelsUpToEight) {
+TEST(PilotBlock, TheLargestSquareWithEnoughPilotPixelsUpToTwelve) {
     EXPECT_EQ(kPilotPixels, 1024);
-    EXPECT_EQ(pilot_block(32, 24), 1);    // 768 pixels: all of them
-    EXPECT_EQ(pilot_block(80, 60), 1);    // squares of 2 would fit, but cost too much: all
-    EXPECT_EQ(pilot_block(127, 128), 1);  // squares of 3.99
-    EXPECT_EQ(pilot_block(128, 128), 4);  // 1,024 of 16,384 pixels
-    EXPECT_EQ(pilot_block(200, 150), 5);  // 1,200 of 30,000
-    EXPECT_EQ(pilot_block(400, 300), 8);  // squares of 10.8 held at 8: 1,875 of 120,000
-    EXPECT_EQ(pilot_block(1600, 1200), 8);
+    EXPECT_EQ(pilot_block(32, 24), 1);     // 768 pixels: all of them
+    EXPECT_EQ(pilot_block(80, 60), 1);     // squares of 2 would fit, but cost too much: all
+    EXPECT_EQ(pilot_block(127, 128), 1);   // squares of 3.99
+    EXPECT_EQ(pilot_block(128, 128), 4);   // 1,024 of 16,384 pixels
+    EXPECT_EQ(pilot_block(200, 150), 5);   // 1,200 of 30,000
+    EXPECT_EQ(pilot_block(400, 300), 10);  // squares of 10.8: 1,200 of 120,000
+    EXPECT_EQ(pilot_block(800, 600), 12);  // squares of 21.7 held at 12: 3,350 of 480,000
+    EXPECT_EQ(pilot_block(1600, 1200), 12);
 }
 
 TEST(Predict, AfterAPilotOfSomePixelsAimsAt95PercentAlongMinusFourFifthsUp) {
