@@ -165,5 +165,30 @@ TEST(RenderContext, APixelBlockRendersOnePixelOfEachSquareAsTheFullRenderDoes) {
     EXPECT_EQ(samples, 4 * picked);
 }
 
+TEST(RenderContext, APilotTileRendersThePickedPixelsOfSquaresThatCrossItsEdges) {
+    // Squares of 5 and 7 do not divide the tiles of 16: a tile holds parts of squares whose
+    // picked pixel may lie in it or in a neighbour.
+    Scene scene = testing::scaled_scene("thesis/test1.xml", 90, 2);
+    scene.settings.height = 61;
+    for (const int block : {5, 7}) {
+        const RenderContext pilot(scene, std::nullopt, true, block);
+        std::uint64_t rendered = 0;
+        for (const Tile& tile : pilot.tiles()) {
+            const TileBuffer buffer = pilot.render_tile(tile);
+            for (int y = tile.y0; y < tile.y1; ++y) {
+                for (int x = tile.x0; x < tile.x1; ++x) {
+                    const std::uint32_t samples =
+                        buffer.pixel_samples[std::size_t(y - tile.y0) * std::size_t(tile.width()) +
+                                             std::size_t(x - tile.x0)];
+                    EXPECT_EQ(samples, pilot.renders(x, y) ? 2u : 0u)
+                        << block << ": " << x << " " << y;
+                    rendered += samples / 2;
+                }
+            }
+        }
+        EXPECT_EQ(rendered, pilot.rendered_pixels()) << block;
+    }
+}
+
 }  // namespace
 }  // namespace drt

@@ -102,10 +102,13 @@ class RenderContext {
     Pixel render_pixel(int x, int y, std::uint64_t path, Scratch& scratch, RayCounts& rays) const;
     Pixel plain_pixel(int x, int y, std::uint64_t path, Scratch& scratch, RayCounts& rays) const;
     Pixel adaptive_pixel(int x, int y, std::uint64_t path, Scratch& scratch, RayCounts& rays) const;
-    // Renders some of the tile's pixels a second time for the error estimate (error_estimate.h)
-    // and adds them to the buffer's error sums; `rendered` are the tile's pixels, row
-    // by row.
-    void calibrate(const Tile& tile, std::span<const Pixel> rendered, Scratch& scratch,
+    // The pixels of `tile` that renders() picks, as indices row by row into the tile.
+    std::vector<std::size_t> rendered_in(const Tile& tile) const;
+    // Renders some of the tile's `rendered` pixels a second time for the error estimate
+    // (error_estimate.h) and adds them to the buffer's error sums; `pixels` are all the tile's,
+    // row by row.
+    void calibrate(const Tile& tile, std::span<const Pixel> pixels,
+                   std::span<const std::size_t> rendered, Scratch& scratch,
                    TileBuffer& buffer) const;
 
     const Scene& scene_;
