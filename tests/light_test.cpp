@@ -7,8 +7,8 @@
 #include <utility>
 #include <vector>
 
-#include "drt/rng.h"
 #include "drt/multi_jittered.h"
+#include "drt/rng.h"
 #include "drt/sampler.h"
 #include "test_math.h"
 
