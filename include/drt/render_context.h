@@ -62,7 +62,8 @@ class RenderContext {
     // How many pixels renders() picks.
     std::uint64_t rendered_pixels() const { return rendered_pixels_; }
 
-    // Renders every pixel of `tile`. Safe to call from several threads at once.
+    // Renders the pixels of `tile` that renders() picks (every one without a pixel block). Safe
+    // to call from several threads at once.
     TileBuffer render_tile(const Tile& tile) const;
 
     // A guess at what render_tile(tile) costs, in shaded rays (camera, reflection and refraction
