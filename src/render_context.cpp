@@ -190,7 +190,7 @@ void RenderContext::calibrate(const Tile& tile, std::span<const Pixel> pixels,
     // difference, not a scale taken from some of them times the spreads of all, which at 8
     // samples follow a pixel's error too loosely (at one pixel in 25 on Test5 at --scale 0.25
     // the log scatter against the true RMSE fell from 0.166 to 0.116, close to the 0.108 that
-    // the choice of pixels alone leaves; docs/accuracy.md, section 6). It costs the pilot 40-85 %
+    // the choice of pixels alone leaves; docs/accuracy-history.md). It costs the pilot 40-85 %
     // more samples, at most a fifth of one sample per image pixel (0.18 at 200 x 150, 0.05 at
     // 400 x 300 and at 800 x 600).
     const std::vector<double> odds =

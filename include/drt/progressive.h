@@ -68,12 +68,12 @@ struct ProgressiveRound {
 inline constexpr double kPilotPixels = 1024;
 // A pilot of some pixels takes at most one pixel in kMinPilotBlock squared: a costlier one, not
 // kept, loses more than a full pilot, kept, does (at --scale 0.1, 80 x 60, one pixel in 2 x 2
-// made the thesis scenes' goal renders 4 % dearer, docs/accuracy.md section 6).
+// made the thesis scenes' goal renders 4 % dearer, docs/accuracy-history.md).
 inline constexpr int kMinPilotBlock = 4;
 // And at least one in kMaxPilotBlock squared: beyond, it costs too little to matter. Its pixels
 // rendered twice, one in 12 x 12 costs 0.11 samples per image pixel, under 4 % of the 3 spp that
 // reach an RMSE of 0.01 on Test1 at 800 x 600 (one in 8 x 8, the cap before, cost 0.25, and Test1,
-// Test4 and Test5 at 800 x 600 took 4 % more samples; docs/accuracy.md section 6).
+// Test4 and Test5 at 800 x 600 took 4 % more samples; docs/accuracy-history.md).
 inline constexpr int kMaxPilotBlock = 12;
 // The side b of the squares of which a render to a target error pilots one pixel: the largest
 // with at least kPilotPixels squares, at most kMaxPilotBlock; 1 (a full pilot, kept) where that
