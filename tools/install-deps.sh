@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages drt needs to build and test; does nothing when all are present.
 # Usage: tools/install-deps.sh [--study] [--bench] [extra-package ...]
-#   --study  also gnuplot-nox, which tools/accuracy-study.sh needs to draw its plots
+#   --study  also gnuplot-nox, which tools/accuracy-study.sh needs to draw its plots, and python3
+#            for tools/allocation-bound.py
 #   --bench  also libbenchmark-dev, povray, time and libembree-dev, which bench/ needs
 #            (docs/performance.md)
 set -euo pipefail
@@ -14,7 +15,7 @@ packages=(g++ cmake make pkg-config libtinyxml2-dev libstb-dev libcli11-dev libo
           openmpi-bin)
 for arg in "$@"; do
     case "$arg" in
-        --study) packages+=(gnuplot-nox) ;;
+        --study) packages+=(gnuplot-nox python3) ;;
         --bench) packages+=(libbenchmark-dev povray time libembree-dev) ;;
         *) packages+=("$arg") ;;
     esac
