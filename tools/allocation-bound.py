@@ -26,6 +26,9 @@ import array
 import math
 import sys
 
+# A round meant as the last aims at this share of the target (kSpareShare, progressive.h).
+SPARE_SHARE = 0.98
+
 
 def fail(message):
     print(f"allocation-bound: {message}", file=sys.stderr)
@@ -103,11 +106,13 @@ def main():
     parser.add_argument("--min", type=float, default=2, help="the fewest samples of any pixel")
     parser.add_argument("--top-up", type=int, help="samples of a top-up round on some pixels")
     args = parser.parse_args()
+    if args.spp < 1 or (args.top_up is not None and args.top_up < 1):
+        fail("the samples per pixel (N, --top-up) must be at least 1")
     width, height, variances = pixel_variances(args.error_image)
     rmse = math.sqrt(sum(variances) / len(variances))
     print(f"{args.error_image}: estimated RMSE {rmse:.5f} at {args.spp} spp")
     order = None
-    if args.top_up:
+    if args.top_up is not None:
         around = neighbours_largest(width, height, variances)
         order = sorted(range(len(variances)), key=lambda i: -around[i])
     for target in map(float, args.targets.split(",")):
@@ -116,9 +121,10 @@ def main():
             per_pixel = fewest_samples(variances, args.spp, target, alpha, args.min)
             print(f"E {target} alpha {alpha}: uniform {uniform:.1f} spp, per pixel {per_pixel:.1f} "
                   f"spp on average ({per_pixel / uniform:.2f} of uniform)")
-            if order is None or rmse <= 0.98 * target:
+            goal = SPARE_SHARE * target
+            if order is None or rmse <= goal:
                 continue
-            share = top_up_share(variances, order, args.spp, 0.98 * target, alpha, args.top_up)
+            share = top_up_share(variances, order, args.spp, goal, alpha, args.top_up)
             if share is None:
                 print(f"  a top-up of {args.top_up} spp on every pixel does not reach 0.98 E")
             else:
