@@ -175,7 +175,14 @@ std::string goal_summary(const std::string& name, const ProgressiveResult& p, co
     std::ostringstream line;
     line << "drt: " << name << ": " << p.samples << " spp after ";
     const char* separator = "rounds of ";
+    std::ostringstream top_ups;
     for (const ProgressiveRound& r : p.rounds) {
+        if (r.top_up()) {
+            top_ups << ", a top-up of 2 x " << r.spp << " spp on " << std::fixed
+                    << std::setprecision(2) << 100 * r.top_up_share << std::defaultfloat
+                    << " % of the pixels";
+            continue;
+        }
         if (!r.full()) {
             line << "a pilot of " << r.spp << " spp on 1 pixel in " << r.pixel_block * r.pixel_block
                  << ", ";
@@ -184,7 +191,8 @@ std::string goal_summary(const std::string& name, const ProgressiveResult& p, co
         line << separator << r.spp;
         separator = ", ";
     }
-    line << " spp; estimated rmse " << (p.error ? short_number(*p.error) : std::string("n/a"));
+    line << " spp" << top_ups.str() << "; estimated rmse "
+         << (p.error ? short_number(*p.error) : std::string("n/a"));
     if (goal.target_error) {
         line << " (target " << short_number(*goal.target_error)
              << (p.target_met ? " met)" : " not met)");
@@ -193,8 +201,9 @@ std::string goal_summary(const std::string& name, const ProgressiveResult& p, co
         line << "; " << std::fixed << std::setprecision(2) << seconds << " s of the "
              << short_number(*goal.time_limit) << " s limit" << std::defaultfloat;
     }
-    const auto full = std::count_if(p.rounds.begin(), p.rounds.end(),
-                                    [](const ProgressiveRound& r) { return r.full(); });
+    const auto full =
+        std::count_if(p.rounds.begin(), p.rounds.end(),
+                      [](const ProgressiveRound& r) { return r.full() || r.top_up(); });
     if (!p.combined || full == 1) {
         // A target error's one full round is the plain render of its count (progressive.h).
         line << "\ndrt: " << name << ": --spp " << p.samples

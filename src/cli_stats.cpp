@@ -55,7 +55,11 @@ std::string goal_json(const ProgressiveResult& p, const std::optional<double>& t
         j << (i ? ", " : "") << "{\"spp\": " << r.spp;
         // A pilot of one pixel in b x b is not part of the image. A full round's seed renders it
         // alone (--spp N --seed S): a string, as 64 bits are beyond a JSON number's exact range.
-        if (!r.full()) {
+        if (r.top_up()) {
+            // Its seed's pattern covers only some pixels: no plain render repeats it.
+            j << ", \"top_up_share\": " << json_number(r.top_up_share);
+            ++full;
+        } else if (!r.full()) {
             j << ", \"pilot_pixel_block\": " << r.pixel_block;
         } else if (p.combined) {
             j << ", \"seed\": \"" << round_seed(seed, full++) << "\"";

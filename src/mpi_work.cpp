@@ -66,6 +66,7 @@ enum Tag : int {
     kGrant,        // from the leader: tile indices; none means there is no more work
     kResult,       // to the leader: one finished tile (encode_tile)
     kDone,         // to the leader: tile indices handed out but not rendered; nothing follows
+    kShared,       // from the leader, between renders: 32-bit values (MpiJob::leaders)
 };
 
 // How long a communication thread sleeps while it waits for a message: at first short against
@@ -464,6 +465,23 @@ MpiJob::~MpiJob() = default;
 
 int MpiJob::leaders(int value) const {
     return transport_->leaders(value);
+}
+
+std::vector<std::uint32_t> MpiJob::leaders(std::vector<std::uint32_t> values) const {
+    if (leader()) {
+        std::vector<unsigned char> bytes(values.size() * sizeof(std::uint32_t));
+        if (!values.empty()) std::memcpy(bytes.data(), values.data(), bytes.size());
+        for (int to = 1; to < size(); ++to) transport_->send(to, kShared, bytes);
+        return values;
+    }
+    const std::vector<unsigned char> bytes = transport_->receive(0, kShared);
+    if (bytes.size() % sizeof(std::uint32_t) != 0) {
+        throw std::runtime_error("MPI: shared values of " + std::to_string(bytes.size()) +
+                                 " bytes");
+    }
+    values.resize(bytes.size() / sizeof(std::uint32_t));
+    if (!values.empty()) std::memcpy(values.data(), bytes.data(), bytes.size());
+    return values;
 }
 
 int MpiJob::highest(int value) const {

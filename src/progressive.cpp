@@ -5,6 +5,8 @@
 #include <condition_variable>
 #include <limits>
 #include <mutex>
+#include <numeric>
+#include <span>
 #include <stop_token>
 #include <string>
 #include <thread>
@@ -70,7 +72,9 @@ struct Line {
 // sample, neither negative, so a noisy pair of times never predicts a free sample. After a pilot
 // of some pixels, its own set-up and the rest of its time: at 400 x 300 its set-up is a quarter
 // of its time, and counted as samples it predicted 1.6 times a full round's time.
-Line time_line(const std::vector<ProgressiveRound>& rounds) {
+Line time_line(std::vector<ProgressiveRound> rounds) {
+    // A top-up's time is mostly its set-up: it says little of a full round's.
+    std::erase_if(rounds, [](const ProgressiveRound& r) { return r.top_up(); });
     const ProgressiveRound& last = rounds.back();
     if (!last.full()) {
         const double setup = std::clamp(last.setup_seconds, 0.0, last.seconds);
@@ -102,6 +106,13 @@ class Alarm {
     std::jthread thread_;
 };
 
+// A top-up's pixel variance (two renders of m samples averaged) over the same pixel's at n
+// samples: along kSmallRoundSlope below n, along kIndependentSlope above.
+double top_up_variance_ratio(int n, int m) {
+    const double slope = m < n ? kSmallRoundSlope : kIndependentSlope;
+    return std::pow(double(m) / n, 2 * slope) / 2;
+}
+
 // The rounds of a render to a target error added up: each pixel the mean of the rounds' values
 // weighted by round_weight, and the variance of that mean, the rounds' variances (spread x
 // scale) times their weights squared. Sums in double, in round order: the same bits however the
@@ -112,7 +123,8 @@ class Combination {
         : width_(width),
           height_(height),
           sum_(3 * std::size_t(width) * height),
-          variance_(sum_.size()) {}
+          variance_(sum_.size()),
+          weights_(sum_.size() / 3) {}
 
     void add(const RenderResult& r, int spp) {
         const double scale = r.stats.error.available() ? r.stats.error.scale : 0;
@@ -121,13 +133,42 @@ class Combination {
             sum_[i] += weight * r.image.rgb[i];
             variance_[i] += weight * weight * scale * r.spread.rgb[i];
         }
-        weights_ += weight;
+        for (double& w : weights_) w += weight;
         samples_ += spp;
-        stats_.rays += r.stats.rays;
-        stats_.samples += r.stats.samples;
-        stats_.seconds += r.stats.seconds;
+        count(r);
         calibration_ += r.stats.error.cost * double(r.stats.samples);
         if (!r.stats.error.available()) unavailable_ = r.stats.error.unavailable;
+    }
+
+    // A top-up round of `spp` samples twice on `pixels`. There, its weight against the rounds
+    // before is the ratio of their mean variance over the pixels to its own: one weight for all
+    // of them, which no pixel's own samples decide. Its variance is half a render's (its pixels
+    // are the mean of two), from its estimate where it has one, otherwise predicted as
+    // plan_top_up does.
+    void add_top_up(const RenderResult& r, int spp, std::span<const std::uint32_t> pixels) {
+        double before = 0, own = 0;
+        for (const std::uint32_t p : pixels) {
+            for (std::size_t c = 3 * std::size_t(p); c < 3 * std::size_t(p) + 3; ++c) {
+                before += variance_[c] / (weights_[p] * weights_[p]);
+                own += r.spread.rgb[c];
+            }
+        }
+        const double scale = r.stats.error.available() ? r.stats.error.scale / 2 : 0;
+        const bool estimated = scale * own > 0 && std::isfinite(scale * own);
+        const double predicted = top_up_variance_ratio(samples_, spp);
+        const double ratio = estimated ? before / (scale * own) : 1 / predicted;
+        for (const std::uint32_t p : pixels) {
+            const double weight = ratio * weights_[p];
+            for (std::size_t c = 3 * std::size_t(p); c < 3 * std::size_t(p) + 3; ++c) {
+                const double variance =
+                    estimated ? scale * r.spread.rgb[c]
+                              : predicted * variance_[c] / (weights_[p] * weights_[p]);
+                sum_[c] += weight * r.image.rgb[c];
+                variance_[c] += weight * weight * variance;
+            }
+            weights_[p] += weight;
+        }
+        count(r);
     }
 
     // The image so far, with `last`'s plan and per-process figures.
@@ -140,8 +181,8 @@ class Combination {
         out.stats.tail_seconds = last.stats.tail_seconds;
         out.image = Image(width_, height_);
         out.spread = Image(width_, height_);
-        const double n = weights_;
         for (std::size_t i = 0; i < sum_.size(); ++i) {
+            const double n = weights_[i / 3];
             out.image.rgb[i] = static_cast<float>(sum_[i] / n);
             out.spread.rgb[i] = static_cast<float>(variance_[i] / (n * n));
         }
@@ -156,9 +197,15 @@ class Combination {
     }
 
   private:
+    void count(const RenderResult& r) {
+        stats_.rays += r.stats.rays;
+        stats_.samples += r.stats.samples;
+        stats_.seconds += r.stats.seconds;
+    }
+
     int width_, height_;
     std::vector<double> sum_, variance_;  // per channel: sum of weight x value, weight^2 x variance
-    double weights_ = 0;
+    std::vector<double> weights_;         // per pixel
     int samples_ = 0;
     RenderStats stats_;
     double calibration_ = 0;   // camera samples the rounds' calibrations took
@@ -178,6 +225,58 @@ double predicted_seconds(const std::vector<ProgressiveRound>& rounds, int spp) {
     if (rounds.empty()) return 0;
     const Line line = time_line(rounds);
     return line.setup + line.per_sample * spp * (1 + full_round_calibration(rounds));
+}
+
+std::optional<TopUp> plan_top_up(const Image& variance, int samples, double goal, int most_spp) {
+    const auto width = static_cast<std::size_t>(variance.width);
+    const auto height = static_cast<std::size_t>(variance.height);
+    const std::size_t count = width * height;
+    if (count == 0 || samples < 1) return std::nullopt;
+    std::vector<double> v(count);
+    double total = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+        v[i] =
+            (double(variance.rgb[3 * i]) + variance.rgb[3 * i + 1] + variance.rgb[3 * i + 2]) / 3;
+        total += v[i];
+    }
+    const double need = total - goal * goal * double(count);
+    if (!(need > 0) || !std::isfinite(total)) return std::nullopt;
+    std::vector<double> around(count, 0.0);
+    for (std::size_t y = 0; y < height; ++y) {
+        for (std::size_t x = 0; x < width; ++x) {
+            double& most = around[y * width + x];
+            for (std::size_t ny = y == 0 ? 0 : y - 1; ny <= std::min(y + 1, height - 1); ++ny) {
+                for (std::size_t nx = x == 0 ? 0 : x - 1; nx <= std::min(x + 1, width - 1); ++nx) {
+                    if (nx != x || ny != y) most = std::max(most, v[ny * width + nx]);
+                }
+            }
+        }
+    }
+    std::vector<std::uint32_t> order(count);
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return around[a] > around[b]; });
+    // taken[k]: the variance of the first k pixels in that order.
+    std::vector<double> taken(count + 1, 0.0);
+    for (std::size_t k = 0; k < count; ++k) taken[k + 1] = taken[k] + v[order[k]];
+    std::optional<TopUp> best;
+    std::size_t best_pixels = 0;
+    for (int m = kMinRound; m <= std::min(samples, most_spp / 2); ++m) {
+        // Two estimates combined by inverse variance take v / (1 + ratio) off a pixel's v.
+        const double cut = 1 / (1 + top_up_variance_ratio(samples, m));
+        const auto reach = std::lower_bound(taken.begin(), taken.end(), need / cut);
+        if (reach == taken.end()) continue;
+        const auto pixels = std::max(kMinTopUpPixels, std::size_t(reach - taken.begin()));
+        if (pixels > count) continue;
+        if (!best || double(pixels) * m < double(best_pixels) * best->spp) {
+            best = TopUp{m, {}};
+            best_pixels = pixels;
+        }
+    }
+    if (!best) return std::nullopt;
+    best->pixels.assign(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(best_pixels));
+    std::sort(best->pixels.begin(), best->pixels.end());
+    return best;
 }
 
 int pilot_block(int width, int height) {
@@ -205,7 +304,7 @@ std::optional<Prediction> predict(const std::vector<ProgressiveRound>& rounds, d
     std::optional<double> now;
     bool image = false;
     for (const ProgressiveRound& r : rounds) {
-        if (r.full()) {
+        if (r.full() || r.top_up()) {
             image = true;
             now = r.combined;
         }
@@ -292,6 +391,7 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
                     : 1;
     std::size_t full_rounds = 0;
     int spp = std::min(kFirstPilot, goal.max_samples);
+    std::vector<std::uint32_t> top_up;  // a top-up round's pixels
     while (spp > 0) {
         scene.settings.samples = spp;
         if (out.combined) scene.settings.seed = round_seed(seed, full_rounds);
@@ -308,12 +408,16 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
         RenderJobOptions run = options;
         run.stop = stopper.get_token();
         run.pixel_block = block;
+        run.top_up = top_up;
         // Ordering a pilot's tiles by cost would trace a sixteenth of a sample in every pixel:
-        // a fifth of what the pilot itself traces at one pixel in 25.
-        run.costly_first = options.costly_first && block == 1;
+        // a fifth of what the pilot itself traces at one pixel in 25. A top-up's likewise.
+        run.costly_first = options.costly_first && block == 1 && top_up.empty();
         RenderJobResult job = run_render_job(scene, run);
         alarm.reset();
         int next = 0;
+        std::vector<std::uint32_t> next_pixels;  // the next round's, when a top-up
+        double top_up_cost = 0;
+        int full_next = 0;  // the full round a top-up replaces
         if (!leader) {
             if (block == 1) out.job = std::move(job);
         } else if (!job.complete()) {
@@ -324,12 +428,21 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
             ProgressiveRound done{
                 spp,   stats.seconds,    estimated_error(job.render), std::nullopt,
                 block, stats.error.cost, stats.setup_seconds};
+            const auto image_pixels = std::size_t(job.render.image.width) * job.render.image.height;
+            if (!top_up.empty()) {
+                done.top_up_share = double(top_up.size()) / double(image_pixels);
+                done.calibration = 1;
+            }
             // A pilot of some pixels is measured, not kept.
-            if (done.full()) {
+            if (done.full() || done.top_up()) {
                 if (out.combined) {
                     if (!combination)
                         combination.emplace(job.render.image.width, job.render.image.height);
-                    combination->add(job.render, spp);
+                    if (done.top_up()) {
+                        combination->add_top_up(job.render, spp, top_up);
+                    } else {
+                        combination->add(job.render, spp);
+                    }
                     job.render = combination->result(job.render);
                 }
                 done.combined = estimated_error(job.render);
@@ -343,6 +456,21 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
             if (goal.target_error) {
                 const NextRound n = next_round(out.rounds, *goal.target_error, goal.max_samples);
                 next = n.final && goal.pilots_only ? 0 : n.spp;
+                // A final round that would only make up a near miss: where a few pixels carry
+                // most of the shortfall, a top-up of those costs less than a whole round.
+                if (next > 0 && n.final && combination) {
+                    const int total = total_samples(out.rounds);
+                    std::optional<TopUp> t =
+                        plan_top_up(out.job.render.spread, total, kSpareShare * *goal.target_error,
+                                    goal.max_samples - total);
+                    if (t &&
+                        t->cost(image_pixels) < next * (1 + full_round_calibration(out.rounds))) {
+                        next = t->spp;
+                        next_pixels = std::move(t->pixels);
+                        top_up_cost = t->cost(image_pixels);
+                        full_next = n.spp;
+                    }
+                }
             } else if (spp < goal.max_samples) {
                 next = static_cast<int>(std::min(kMaxGrowth * spp, double(goal.max_samples)));
             }
@@ -355,11 +483,20 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
                 // one a quarter larger is worth its time. After a pilot, the first full round
                 // whatever the time: the image.
                 const double least = out.combined ? kMinRound : 1.25 * spp;
-                if (fits < next) next = fits >= least ? static_cast<int>(fits) : 0;
-                if (!done.full()) next = std::max(next, kMinRound);
+                if (!next_pixels.empty() &&
+                    top_up_cost > fits * (1 + full_round_calibration(out.rounds))) {
+                    next_pixels.clear();
+                    next = full_next;
+                }
+                if (next_pixels.empty() && fits < next) {
+                    next = fits >= least ? static_cast<int>(fits) : 0;
+                }
+                if (done.pixel_block > 1) next = std::max(next, kMinRound);
             }
         }
         spp = options.mpi ? options.mpi->leaders(next) : next;
+        top_up =
+            options.mpi ? options.mpi->leaders(std::move(next_pixels)) : std::move(next_pixels);
         if (block == 1) ++full_rounds;
         block = 1;
     }

@@ -56,7 +56,8 @@ std::unique_ptr<Sampler> sampler_named(const std::string& name) {
 }  // namespace
 
 RenderContext::RenderContext(const Scene& scene, std::optional<AdaptiveSampling> adaptive,
-                             bool estimate_error, int pixel_block)
+                             bool estimate_error, int pixel_block,
+                             std::span<const std::uint32_t> top_up)
     : scene_(scene),
       sampler_(sampler_named(scene.settings.sampler)),
       plan_(plan_render(scene)),
@@ -73,6 +74,18 @@ RenderContext::RenderContext(const Scene& scene, std::optional<AdaptiveSampling>
     const auto width = static_cast<std::uint64_t>(scene.settings.width);
     const auto height = static_cast<std::uint64_t>(scene.settings.height);
     const auto b = static_cast<std::uint64_t>(pixel_block_);
+    if (!top_up.empty()) {
+        if (b != 1) throw std::invalid_argument("a top-up round with a pixel block");
+        top_up_.assign(width * height, false);
+        for (const std::uint32_t i : top_up) {
+            if (i >= top_up_.size() || top_up_[i]) {
+                throw std::invalid_argument("a top-up pixel outside the image or named twice");
+            }
+            top_up_[i] = true;
+        }
+        rendered_pixels_ = top_up.size();
+        return;
+    }
     if (b == 1) rendered_pixels_ = width * height;
     for (std::uint64_t sy = 0; b > 1 && sy * b < height; ++sy) {
         for (std::uint64_t sx = 0; sx * b < width; ++sx) {
@@ -92,6 +105,10 @@ std::uint64_t RenderContext::picked_place(std::uint64_t sx, std::uint64_t sy) co
 }
 
 bool RenderContext::renders(int x, int y) const {
+    if (!top_up_.empty()) {
+        return top_up_[static_cast<std::size_t>(y) * std::size_t(scene_.settings.width) +
+                       static_cast<std::size_t>(x)];
+    }
     if (pixel_block_ == 1) return true;
     const auto b = static_cast<std::uint64_t>(pixel_block_);
     const auto ux = static_cast<std::uint64_t>(x), uy = static_cast<std::uint64_t>(y);
@@ -105,6 +122,17 @@ SpreadKind RenderContext::spread_kind() const {
 std::vector<std::size_t> RenderContext::rendered_in(const Tile& tile) const {
     const auto width = static_cast<std::size_t>(tile.width());
     std::vector<std::size_t> rendered;
+    if (!top_up_.empty()) {
+        for (int y = tile.y0; y < tile.y1; ++y) {
+            for (int x = tile.x0; x < tile.x1; ++x) {
+                if (renders(x, y)) {
+                    rendered.push_back(static_cast<std::size_t>(y - tile.y0) * width +
+                                       static_cast<std::size_t>(x - tile.x0));
+                }
+            }
+        }
+        return rendered;
+    }
     if (pixel_block_ == 1) {
         rendered.resize(width * static_cast<std::size_t>(tile.height()));
         std::iota(rendered.begin(), rendered.end(), std::size_t{0});
@@ -150,8 +178,10 @@ TileBuffer RenderContext::render_tile(const Tile& tile) const {
         buffer.samples += pixel.samples;
         buffer.converged += pixel.converged ? 1 : 0;
     }
-    if (estimate_error_ && spread_kind() == SpreadKind::kCalibrated &&
-        scene_.settings.samples >= 2) {
+    if (!top_up_.empty()) {
+        render_again(tile, pixels, rendered, scratch, buffer);
+    } else if (estimate_error_ && spread_kind() == SpreadKind::kCalibrated &&
+               scene_.settings.samples >= 2) {
         calibrate(tile, pixels, rendered, scratch, buffer);
     }
     return buffer;
@@ -209,6 +239,25 @@ void RenderContext::calibrate(const Tile& tile, std::span<const Pixel> pixels,
         const Pixel again = render_pixel(x, y, kCalibrationPath, scratch, rays);
         add_calibration(buffer.error_sums, pixels[i].value, again.value, pixels[i].spread, odds[i],
                         again.samples);
+    }
+}
+
+void RenderContext::render_again(const Tile& tile, std::span<const Pixel> pixels,
+                                 std::span<const std::size_t> rendered, Scratch& scratch,
+                                 TileBuffer& buffer) const {
+    const bool calibrated = spread_kind() == SpreadKind::kCalibrated;
+    const auto width = static_cast<std::size_t>(tile.width());
+    for (const std::size_t i : rendered) {
+        const int x = static_cast<int>(i % width), y = static_cast<int>(i / width);
+        const Pixel again =
+            render_pixel(tile.x0 + x, tile.y0 + y, kCalibrationPath, scratch, buffer.rays);
+        if (calibrated) {
+            add_calibration(buffer.error_sums, pixels[i].value, again.value, pixels[i].spread, 1.0,
+                            again.samples);
+        }
+        buffer.pixels.set(x, y, (pixels[i].value + again.value) * 0.5);
+        buffer.pixel_samples[i] += again.samples;
+        buffer.samples += again.samples;
     }
 }
 

@@ -39,7 +39,7 @@ RenderJobResult run_render_job(const Scene& scene, const RenderJobOptions& optio
     const auto start = std::chrono::steady_clock::now();
     const RenderContext context(scene, options.adaptive,
                                 options.estimate_error || options.checkpoint.has_value(),
-                                options.pixel_block);
+                                options.pixel_block, options.top_up);
     const bool leader = options.mpi == nullptr || options.mpi->leader();
     RenderJobResult out;
     out.tiles = context.tiles().size();

@@ -195,10 +195,12 @@ TEST_P(MpiProcessesAndThreads, AdaptiveRenderIsTheSingleProcesssBitsAndRayCounts
 }
 
 TEST_F(MpiCli, TargetErrorGivesTheSingleProcesssBits) {
-    // Every round's count and weight is decided on the leader and shared: the same rounds as one
-    // process (here two, 8 and 3 spp, combined).
-    const std::vector<std::string> goal{"--target-error", "0.01", "-q"};
+    // Every round's count and weight is decided on the leader and shared, and so are a top-up
+    // round's pixels: the same rounds as one process (here 8 spp and a top-up, combined).
+    const std::vector<std::string> goal{"--target-error", "0.01", "--stats", "s.json", "-q"};
     ASSERT_EQ(run(small(kMotion, "one.pfm", goal, "32x24")).status, 0);
+    const std::string one = bytes("s.json");
+    EXPECT_NE(one.find("\"top_up_share\": "), std::string::npos) << one;
     const Outcome r = run_mpi(2, small(kMotion, "two.pfm", goal, "32x24"));
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(bytes("two.pfm"), bytes("one.pfm"));

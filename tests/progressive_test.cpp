@@ -388,14 +388,18 @@ TEST_F(GoalCli, TargetErrorIsMetAgainstAHighSampleReference) {
 }
 
 TEST_F(GoalCli, TargetErrorGivesTheSameBitsForAnyThreadCount) {
-    // A target three rounds reach, so the rounds' weights and sums count: 8, 15 and a top-up of 7
-    // spp along -3/4 (8 along -1, before 2026-12-03).
+    // A target three rounds reach, so the rounds' weights and sums count: 8, 15 and a top-up of
+    // 2 x 7 spp on the pixels around the most variance (a third full round of 7 spp before
+    // 2026-12-03).
     std::vector<std::string> images;
     for (const std::string threads : {"1", "2", "3"}) {
         const Outcome r = run({"scene.xml", "--target-error", "0.005", "--width", "32", "--height",
                                "24", "-o", "t" + threads + ".pfm", "--threads", threads});
         ASSERT_EQ(r.status, 0) << r.err;
-        EXPECT_NE(r.err.find("after rounds of 8, 15, 7 spp"), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("after rounds of 8, 15 spp, a top-up of 2 x 7 spp on 8.98 % of the "
+                             "pixels;"),
+                  std::string::npos)
+            << r.err;
         images.push_back(bytes("t" + threads + ".pfm"));
     }
     EXPECT_EQ(images[0], images[1]);
@@ -573,7 +577,8 @@ TEST_F(GoalCli, AGoalStoppedInItsFirstRoundKeepsItsTilesAndPointsToNoCheckpoint)
 }
 
 TEST_F(GoalCli, TargetErrorWithAPilotGivesTheSameBitsForAnyThreadCount) {
-    // A target that takes two full rounds after the pilot (18 and 25 spp).
+    // A target the first full round after the pilot misses (19 spp), and a top-up of 2 x 19 spp
+    // on some pixels meets.
     std::vector<std::string> images;
     std::string summary;
     for (const std::string threads : {"1", "2", "3"}) {
@@ -582,7 +587,8 @@ TEST_F(GoalCli, TargetErrorWithAPilotGivesTheSameBitsForAnyThreadCount) {
         ASSERT_EQ(r.status, 0) << r.err;
         const auto line = regex_groups(r.err,
                                        "(after a pilot of 8 spp on 1 pixel in 16, rounds of "
-                                       "[0-9]+(, [0-9]+)+ spp)");
+                                       "[0-9]+ spp(, a top-up of 2 x [0-9]+ spp on [0-9.]+ % of "
+                                       "the pixels)+;)");
         ASSERT_EQ(line.size(), 3u) << r.err;
         if (summary.empty()) summary = line[1];
         EXPECT_EQ(line[1], summary);

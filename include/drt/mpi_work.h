@@ -66,6 +66,8 @@ class MpiJob {
 
     // The leader's value, on every process (collective).
     int leaders(int value) const;
+    // The leader's values, on every process (collective): the leader sends them to each.
+    std::vector<std::uint32_t> leaders(std::vector<std::uint32_t> values) const;
     // The highest of every process's value, on every process (collective).
     int highest(int value) const;
 

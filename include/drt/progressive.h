@@ -57,11 +57,19 @@ struct ProgressiveRound {
     double calibration = 0;
     // Of `seconds`, what went before and after its tiles (RenderStats::setup_seconds).
     double setup_seconds = 0;
+    // Above 0: a top-up round (plan_top_up) on this share of the image's pixels, each rendered
+    // twice (calibration 1), part of the image there; its `error` is its pixels' own.
+    double top_up_share = 0;
 
-    bool full() const { return pixel_block == 1; }
+    // A round of the whole image.
+    bool full() const { return pixel_block == 1 && top_up_share == 0; }
+    bool top_up() const { return top_up_share > 0; }
     // The camera samples it traced per pixel of the image, its calibration's included: what its
     // time paid for.
-    double cost() const { return spp / double(pixel_block * pixel_block) * (1 + calibration); }
+    double cost() const {
+        const double share = top_up() ? top_up_share : 1 / double(pixel_block * pixel_block);
+        return spp * share * (1 + calibration);
+    }
 };
 
 // A pilot takes at least this many pixels, so that its error estimate stands for the image's.
@@ -138,6 +146,33 @@ struct NextRound {
     bool final = false;
 };
 NextRound next_round(const std::vector<ProgressiveRound>& rounds, double target, int max_samples);
+
+// A top-up round: `spp` samples in each of `pixels` (indices y * width + x, ascending), twice.
+struct TopUp {
+    int spp = 0;
+    std::vector<std::uint32_t> pixels;
+    // Its camera samples per pixel of the image.
+    double cost(std::size_t image_pixels) const {
+        return 2.0 * spp * double(pixels.size()) / double(image_pixels);
+    }
+};
+
+// A top-up round takes at least this many pixels: its own estimate, which weights it against the
+// rounds before, then rests on as many pairs (RenderContext).
+inline constexpr std::size_t kMinTopUpPixels = 64;
+
+// The cheapest top-up round predicted to bring an image of `samples` samples per pixel (full
+// rounds), whose estimated variances of the pixels' means are `variance` (per channel), to an
+// RMSE of `goal`, with at most `most_spp` samples in a pixel's two renders each; absent when
+// none does. The pixels are taken in order of the largest variance among their (up to) eight
+// neighbours, not their own: a pixel's own samples then do not decide whether it is topped up,
+// so the mean the rounds make of it stays unbiased (plan by its own variance and a pixel whose
+// samples happened to agree would keep its error). A pixel's two renders of m samples are
+// predicted to have variance v (n / m)^(3/2) / 2 against its variance v at n (along -3/4 below n,
+// as predict's smaller rounds; along -1/2 above), and to bring it to the two combined. The cost
+// is the camera samples, 2 m per pixel taken; of the counts from 2 to `samples` (or `most_spp`),
+// the cheapest.
+std::optional<TopUp> plan_top_up(const Image& variance, int samples, double goal, int most_spp);
 
 struct ProgressiveResult {
     RenderJobResult job;    // the image kept: the rounds combined, or a time limit's last round

@@ -36,9 +36,13 @@ class RenderContext {
     // error estimate's calibration (its second renders), for a render whose estimate nobody reads.
     // `pixel_block` above 1 renders one pixel of each pixel_block x pixel_block square of the
     // image (see renders()) and leaves the others 0: a pilot that measures the whole image's
-    // error per pixel at a fraction of its cost (progressive.h).
+    // error per pixel at a fraction of its cost (progressive.h). `top_up`, when not empty, the
+    // indices y * width + x of the only pixels rendered (a top-up round, progressive.h): each
+    // twice, with independent patterns, and the two averaged; for a stratified or Sobol sampler
+    // every pair's difference calibrates the estimate, which is then the top-up pixels' own.
     RenderContext(const Scene& scene, std::optional<AdaptiveSampling> adaptive,
-                  bool estimate_error = true, int pixel_block = 1);
+                  bool estimate_error = true, int pixel_block = 1,
+                  std::span<const std::uint32_t> top_up = {});
     // The integrator refers to the sampler, plan and BVH held here: the context stays put.
     RenderContext(const RenderContext&) = delete;
     RenderContext& operator=(const RenderContext&) = delete;
@@ -57,7 +61,7 @@ class RenderContext {
     // its b x b square (squares aligned to the image's corner) that a hash of the seed and the
     // square picks among b x b places; a square cut by the image's edge may then have none, so
     // that every pixel has the same odds, 1 / b^2, and the rendered pixels' mean error is an
-    // unbiased guess at the image's.
+    // unbiased guess at the image's. With top-up pixels, those.
     bool renders(int x, int y) const;
     // How many pixels renders() picks.
     std::uint64_t rendered_pixels() const { return rendered_pixels_; }
@@ -111,6 +115,11 @@ class RenderContext {
     void calibrate(const Tile& tile, std::span<const Pixel> pixels,
                    std::span<const std::size_t> rendered, Scratch& scratch,
                    TileBuffer& buffer) const;
+    // A top-up's second render of each of the tile's `rendered` pixels: averaged into the
+    // buffer's pixels, and their difference added to its error sums (for a calibrated sampler).
+    void render_again(const Tile& tile, std::span<const Pixel> pixels,
+                      std::span<const std::size_t> rendered, Scratch& scratch,
+                      TileBuffer& buffer) const;
 
     const Scene& scene_;
     std::unique_ptr<Sampler> sampler_;
@@ -120,6 +129,7 @@ class RenderContext {
     std::optional<AdaptiveSampling> adaptive_;
     bool estimate_error_;
     int pixel_block_;
+    std::vector<bool> top_up_;  // per pixel, row by row; empty: not a top-up
     std::uint64_t rendered_pixels_ = 0;
     std::vector<Tile> tiles_;
 };

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -40,6 +41,9 @@ struct RenderJobOptions {
     // (RenderContext): a render to a target error's pilot (progressive.h), which keeps no
     // checkpoint (the checkpoint's fingerprint does not know this).
     int pixel_block = 1;
+    // Not empty: a render to a target error's top-up round (progressive.h), which renders only
+    // these pixels (indices y * width + x, ascending), each twice (RenderContext); no checkpoint.
+    std::vector<std::uint32_t> top_up;
     std::stop_token stop;
     const MpiJob* mpi = nullptr;  // absent: one process
 };
