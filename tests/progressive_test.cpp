@@ -6,6 +6,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -339,6 +340,152 @@ TEST(RenderProgressively, TheImageIsTheRoundsWeightedByTheirInverseEstimatedVari
               alone[0].stats.rays.total() + alone[1].stats.rays.total());
 }
 
+// ---- a top-up round on some pixels
+// -------------------------------------------------------------
+
+// A 16 x 16 variance image (the same in every channel): 1e-6 everywhere but at `spikes`.
+Image variances(std::initializer_list<std::pair<int, double>> spikes) {
+    Image v(16, 16);
+    for (float& x : v.rgb) x = 1e-6f;
+    for (const auto& [pixel, value] : spikes) {
+        for (int c = 0; c < 3; ++c) v.rgb[3 * std::size_t(pixel) + c] = static_cast<float>(value);
+    }
+    return v;
+}
+
+// The goal whose shortfall, the variance summed over pixels above goal^2 per pixel, is `need`.
+double goal_short_by(const Image& v, double need) {
+    double total = 0;
+    for (const float x : v.rgb) total += x / 3.0;
+    return std::sqrt((total - need) / 256);
+}
+
+TEST(PlanTopUp, TakesPixelsByTheirNeighboursVarianceNotTheirOwn) {
+    // One pixel, (8, 8), holds most of the variance; a shortfall of 1.47e-5 (14.7 quiet pixels).
+    const int spike = 8 * 16 + 8;
+    const Image v = variances({{spike, 1e-3}});
+    const auto plan = plan_top_up(v, 8, goal_short_by(v, 1.47e-5), 1000);
+    ASSERT_TRUE(plan);
+    // Two renders of 2 samples take v / (1 + (2/8)^(-3/2) / 2) = v / 5 off a pixel: its 8
+    // neighbours and then quiet pixels in index order, 74 in all (74 / 5 > 14.7 quiet pixels'
+    // worth); 3 samples would take 64 pixels (the least) for 192 samples against 2 x 74 = 148.
+    EXPECT_EQ(plan->spp, 2);
+    ASSERT_EQ(plan->pixels.size(), 74u);
+    EXPECT_TRUE(std::is_sorted(plan->pixels.begin(), plan->pixels.end()));
+    const auto has = [&](int pixel) {
+        return std::binary_search(plan->pixels.begin(), plan->pixels.end(),
+                                  static_cast<std::uint32_t>(pixel));
+    };
+    for (const int d : {-17, -16, -15, -1, 1, 15, 16, 17}) EXPECT_TRUE(has(spike + d)) << d;
+    // Its own samples do not decide it: their neighbours are quiet.
+    EXPECT_FALSE(has(spike));
+    EXPECT_TRUE(has(0));
+    EXPECT_DOUBLE_EQ(plan->cost(256), 2.0 * 2 * 74 / 256);
+    // Two spikes side by side: each is the other's neighbour, so both are taken first.
+    const Image pair = variances({{spike, 1e-3}, {spike + 1, 1e-3}});
+    const auto both = plan_top_up(pair, 8, goal_short_by(pair, 1e-3), 1000);
+    ASSERT_TRUE(both);
+    EXPECT_TRUE(std::binary_search(both->pixels.begin(), both->pixels.end(), spike));
+    EXPECT_TRUE(std::binary_search(both->pixels.begin(), both->pixels.end(), spike + 1));
+}
+
+TEST(PlanTopUp, AtLeast64PixelsWithinTheSamplesLeftOrNone) {
+    const Image v = variances({{8 * 16 + 8, 1e-3}});
+    // A shortfall the spike's neighbours alone make up still takes 64 pixels, at the cheapest
+    // count that reaches with them: 3 (2 would need 75).
+    const auto least = plan_top_up(v, 8, goal_short_by(v, 1e-5), 1000);
+    ASSERT_TRUE(least);
+    EXPECT_EQ(least->pixels.size(), kMinTopUpPixels);
+    // No more than the samples left (here 5: renders of 2 each), nor more than the image's
+    // samples so far.
+    const auto capped = plan_top_up(v, 8, goal_short_by(v, 1e-5), 5);
+    ASSERT_TRUE(capped);
+    EXPECT_EQ(capped->spp, 2);
+    EXPECT_EQ(plan_top_up(v, 8, goal_short_by(v, 1e-5), 3), std::nullopt);
+    // The goal met already, or out of reach even with every pixel topped up twice by 8: none.
+    EXPECT_EQ(plan_top_up(v, 8, 1, 1000), std::nullopt);
+    EXPECT_EQ(plan_top_up(v, 8, goal_short_by(v, 0.9e-3), 1000), std::nullopt);
+}
+
+TEST(RenderProgressively, ATopUpIsWeightedByTheRatioOfTheMeanVariancesOverItsPixels) {
+    LoadedScene loaded = load_scene_from_string(kScene, "scene.xml");
+    Scene& scene = loaded.scene;
+    scene.settings.width = 32;
+    scene.settings.height = 24;
+    ProgressiveGoal goal;
+    goal.target_error = 0.005;
+    goal.max_samples = 1000;
+    RenderJobOptions options;
+    options.threads = 2;
+    const ProgressiveResult p = render_progressively(scene, options, goal);
+    // As GoalCli.TargetErrorGivesTheSameBitsForAnyThreadCount: 8, 15, then 2 x 7 on some pixels.
+    ASSERT_EQ(p.rounds.size(), 3u);
+    ASSERT_TRUE(p.rounds[2].top_up());
+    EXPECT_EQ(p.samples, 23);
+    // The two full rounds combined, as the image before the top-up.
+    std::vector<RenderResult> alone;
+    for (std::size_t i = 0; i < 2; ++i) {
+        scene.settings.samples = p.rounds[i].spp;
+        scene.settings.seed = round_seed(3, i);
+        alone.push_back(run_render_job(scene, options).render);
+    }
+    const double w0 = round_weight(alone[0].stats.error.rmse, 8);
+    const double w1 = round_weight(alone[1].stats.error.rmse, 15);
+    const std::size_t n = alone[0].image.rgb.size();
+    std::vector<double> mean(n), variance(n);
+    Image before(32, 24);
+    for (std::size_t i = 0; i < n; ++i) {
+        mean[i] = (w0 * alone[0].image.rgb[i] + w1 * alone[1].image.rgb[i]) / (w0 + w1);
+        variance[i] = (w0 * w0 * alone[0].stats.error.scale * alone[0].spread.rgb[i] +
+                       w1 * w1 * alone[1].stats.error.scale * alone[1].spread.rgb[i]) /
+                      ((w0 + w1) * (w0 + w1));
+        before.rgb[i] = static_cast<float>(variance[i]);
+    }
+    const auto plan = plan_top_up(before, 23, 0.98 * 0.005, 1000 - 23);
+    ASSERT_TRUE(plan);
+    EXPECT_EQ(plan->spp, p.rounds[2].spp);
+    EXPECT_DOUBLE_EQ(p.rounds[2].top_up_share, double(plan->pixels.size()) / (32 * 24));
+    // The top-up alone: its pixels, each the mean of two renders.
+    options.top_up = plan->pixels;
+    scene.settings.samples = plan->spp;
+    scene.settings.seed = round_seed(3, 2);
+    const RenderResult t = run_render_job(scene, options).render;
+    ASSERT_TRUE(t.stats.error.available());
+    EXPECT_EQ(p.rounds[2].error, t.stats.error.rmse);
+    double mean_before = 0, own = 0;
+    for (const std::uint32_t pixel : plan->pixels) {
+        for (std::size_t c = 3 * pixel; c < 3 * pixel + 3; ++c) {
+            mean_before += variance[c];
+            own += t.stats.error.scale / 2 * t.spread.rgb[c];
+        }
+    }
+    const double ratio = mean_before / own;  // the top-up's weight over the rounds' before it
+    std::vector<bool> topped(n / 3, false);
+    for (const std::uint32_t pixel : plan->pixels) topped[pixel] = true;
+    std::size_t differ = 0;
+    double mse = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        double expected = mean[i], var = variance[i];
+        if (topped[i / 3]) {
+            expected = (mean[i] + ratio * t.image.rgb[i]) / (1 + ratio);
+            var = (var + ratio * ratio * t.stats.error.scale / 2 * t.spread.rgb[i]) /
+                  ((1 + ratio) * (1 + ratio));
+        } else {
+            EXPECT_EQ(t.image.rgb[i], 0.0f);  // not rendered
+        }
+        differ += std::abs(p.job.render.image.rgb[i] - expected) > 1e-6 * (1 + std::abs(expected));
+        mse += var;
+    }
+    EXPECT_EQ(differ, 0u);
+    // The estimate: the mean of the pixels' variances, the top-up's included.
+    ASSERT_TRUE(p.error);
+    EXPECT_NEAR(*p.error, std::sqrt(mse / double(n)), 1e-6);
+    EXPECT_LE(*p.error, 0.005);
+    // Every camera sample counted: the top-up's two renders of 7 on its pixels.
+    EXPECT_EQ(p.job.render.stats.samples,
+              alone[0].stats.samples + alone[1].stats.samples + 2 * 7 * plan->pixels.size());
+}
+
 TEST_F(GoalCli, TimeLimitStopsByTheLimitWithThePlainRenderOfTheCountReached) {
     // The random sampler's time per sample is constant, and 12 tiles let a round be stopped
     // between tiles. The largest count, 65536 spp, takes minutes: the limit stops the rounds.
@@ -392,6 +539,7 @@ TEST_F(GoalCli, TargetErrorGivesTheSameBitsForAnyThreadCount) {
     // 2 x 7 spp on the pixels around the most variance (a third full round of 7 spp before
     // 2026-12-03).
     std::vector<std::string> images;
+    std::optional<double> estimate;
     for (const std::string threads : {"1", "2", "3"}) {
         const Outcome r = run({"scene.xml", "--target-error", "0.005", "--width", "32", "--height",
                                "24", "-o", "t" + threads + ".pfm", "--threads", threads});
@@ -400,10 +548,23 @@ TEST_F(GoalCli, TargetErrorGivesTheSameBitsForAnyThreadCount) {
                              "pixels;"),
                   std::string::npos)
             << r.err;
+        const auto stated = regex_groups(r.err, "estimated rmse ([0-9.e-]+)");
+        ASSERT_EQ(stated.size(), 2u) << r.err;
+        estimate = std::stod(stated[1]);
         images.push_back(bytes("t" + threads + ".pfm"));
     }
     EXPECT_EQ(images[0], images[1]);
     EXPECT_EQ(images[0], images[2]);
+    // The top-up leaves the estimate honest and the target met against a reference of another
+    // seed.
+    ASSERT_EQ(run({"scene.xml", "--spp", "2048", "--seed", "4", "--width", "32", "--height", "24",
+                   "-o", "ref.pfm", "-q"})
+                  .status,
+              0);
+    const double error = rmse(read_image(dir_ / "t1.pfm"), read_image(dir_ / "ref.pfm"));
+    EXPECT_LE(error, 1.25 * 0.005);
+    EXPECT_GT(*estimate, error / 1.25);
+    EXPECT_LT(*estimate, error * 1.25);
 }
 
 TEST_F(GoalCli, InfoPredictsTheSamplesAndTimeFromPilots) {

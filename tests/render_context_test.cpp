@@ -190,5 +190,49 @@ TEST(RenderContext, APilotTileRendersThePickedPixelsOfSquaresThatCrossItsEdges) 
     }
 }
 
+TEST(RenderContext, ATopUpRendersItsPixelsTwiceAndAveragesThem) {
+    Scene scene = testing::scaled_scene("thesis/test1.xml", 40, 4);
+    scene.settings.height = 30;
+    // Pixels in three tiles, a corner and an edge among them.
+    const std::vector<std::uint32_t> top_up{0, 17, 39, 40 * 16 + 20, 40 * 29 + 39};
+    const RenderContext full(scene, std::nullopt);
+    const RenderContext again(scene, std::nullopt, true, 1, top_up);
+    EXPECT_EQ(again.rendered_pixels(), top_up.size());
+    std::uint64_t samples = 0;
+    double pairs = 0;
+    for (const Tile& tile : full.tiles()) {
+        const TileBuffer a = full.render_tile(tile);
+        const TileBuffer b = again.render_tile(tile);
+        samples += b.samples;
+        pairs += b.error_sums.pixels;
+        for (int y = tile.y0; y < tile.y1; ++y) {
+            for (int x = tile.x0; x < tile.x1; ++x) {
+                const int tx = x - tile.x0, ty = y - tile.y0;
+                const auto i = static_cast<std::uint32_t>(y * 40 + x);
+                const bool listed = std::find(top_up.begin(), top_up.end(), i) != top_up.end();
+                EXPECT_EQ(again.renders(x, y), listed) << x << " " << y;
+                if (!listed) {
+                    EXPECT_EQ(b.pixels.at(tx, ty), Color{}) << x << " " << y;
+                    continue;
+                }
+                // The mean of the plain render's pixel and an independent second render of it.
+                const Color second = 2.0 * b.pixels.at(tx, ty) + (-1.0) * a.pixels.at(tx, ty);
+                EXPECT_NE(second, a.pixels.at(tx, ty)) << x << " " << y;
+                EXPECT_EQ(b.spread.at(tx, ty), a.spread.at(tx, ty)) << x << " " << y;
+                EXPECT_EQ(
+                    b.pixel_samples[std::size_t(ty) * std::size_t(tile.width()) + std::size_t(tx)],
+                    8u);
+            }
+        }
+    }
+    EXPECT_EQ(samples, 8 * top_up.size());
+    EXPECT_EQ(pairs, double(top_up.size()));  // every pair calibrates the stratified estimate
+    EXPECT_THROW(RenderContext(scene, std::nullopt, true, 1, std::vector<std::uint32_t>{3, 3}),
+                 std::invalid_argument);
+    EXPECT_THROW(RenderContext(scene, std::nullopt, true, 1, std::vector<std::uint32_t>{1200}),
+                 std::invalid_argument);
+    EXPECT_THROW(RenderContext(scene, std::nullopt, true, 4, top_up), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace drt
