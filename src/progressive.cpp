@@ -113,6 +113,19 @@ double top_up_variance_ratio(int n, int m) {
     return std::pow(double(m) / n, 2 * slope) / 2;
 }
 
+// A first top-up's recalibration of the pixels outside it, from a few hundred picked at random,
+// stays within these factors: beyond, a few pixels' noise would decide it.
+constexpr double kLeastRescale = 0.25;
+constexpr double kMostRescale = 4;
+// Keeps a top-up's choice of calibrating pixels apart from other hashes of the seed.
+constexpr std::uint64_t kTopUpCalibrationStream = 0x746f7075ULL;
+
+// A top-up's pixels picked at random to calibrate the others, and their odds.
+struct Calibrating {
+    std::span<const std::uint32_t> pixels;
+    std::span<const double> odds;
+};
+
 // The rounds of a render to a target error added up: each pixel the mean of the rounds' values
 // weighted by round_weight, and the variance of that mean, the rounds' variances (spread x
 // scale) times their weights squared. Sums in double, in round order: the same bits however the
@@ -135,40 +148,41 @@ class Combination {
         }
         for (double& w : weights_) w += weight;
         samples_ += spp;
+        last_spp_ = spp;
+        last_variance_.resize(sum_.size());
+        for (std::size_t i = 0; i < sum_.size(); ++i) last_variance_[i] = scale * r.spread.rgb[i];
         count(r);
         calibration_ += r.stats.error.cost * double(r.stats.samples);
         if (!r.stats.error.available()) unavailable_ = r.stats.error.unavailable;
     }
 
-    // A top-up round of `spp` samples twice on `pixels`. There, its weight against the rounds
-    // before is the ratio of their mean variance over the pixels to its own: one weight for all
-    // of them, which no pixel's own samples decide. Its variance is half a render's (its pixels
-    // are the mean of two), from its estimate where it has one, otherwise predicted as
-    // plan_top_up does.
-    void add_top_up(const RenderResult& r, int spp, std::span<const std::uint32_t> pixels) {
-        double before = 0, own = 0;
-        for (const std::uint32_t p : pixels) {
-            for (std::size_t c = 3 * std::size_t(p); c < 3 * std::size_t(p) + 3; ++c) {
-                before += variance_[c] / (weights_[p] * weights_[p]);
-                own += r.spread.rgb[c];
-            }
+    // A top-up round of `spp` samples twice on `topped` and `calibrating` (its pixels' spreads
+    // the variance of their means, RenderContext). On each of the two sets its weight against the
+    // rounds before is the ratio of their mean variance there to its own: one weight for all of
+    // a set, which no pixel's own samples decide. Where it has no variance to weigh by, along
+    // top_up_variance_ratio. The first top-up of the last full round's count also recalibrates
+    // the rounds' estimate (recalibrate).
+    void add_top_up(const RenderResult& r, int spp, std::span<const std::uint32_t> topped,
+                    const Calibrating& calibrating) {
+        if (!recalibrated_ && spp == last_spp_) {
+            recalibrate(r, topped, calibrating);
+            recalibrated_ = true;
         }
-        const double scale = r.stats.error.available() ? r.stats.error.scale / 2 : 0;
-        const bool estimated = scale * own > 0 && std::isfinite(scale * own);
-        const double predicted = top_up_variance_ratio(samples_, spp);
-        const double ratio = estimated ? before / (scale * own) : 1 / predicted;
-        for (const std::uint32_t p : pixels) {
-            const double weight = ratio * weights_[p];
-            for (std::size_t c = 3 * std::size_t(p); c < 3 * std::size_t(p) + 3; ++c) {
-                const double variance =
-                    estimated ? scale * r.spread.rgb[c]
-                              : predicted * variance_[c] / (weights_[p] * weights_[p]);
-                sum_[c] += weight * r.image.rgb[c];
-                variance_[c] += weight * weight * variance;
-            }
-            weights_[p] += weight;
-        }
+        combine(r, spp, topped);
+        combine(r, spp, calibrating.pixels);
         count(r);
+    }
+
+    // The estimated variance of the mean of two renders of `spp` samples, per pixel and channel:
+    // half the last full round's (recalibrated), along kSmallRoundSlope below its count.
+    Image pair_variance(int spp) const {
+        Image out(width_, height_);
+        const double factor =
+            spp < last_spp_ ? std::pow(double(spp) / last_spp_, 2 * kSmallRoundSlope) : 1.0;
+        for (std::size_t i = 0; i < last_variance_.size(); ++i) {
+            out.rgb[i] = static_cast<float>(last_variance_[i] * factor / 2);
+        }
+        return out;
     }
 
     // The image so far, with `last`'s plan and per-process figures.
@@ -197,6 +211,68 @@ class Combination {
     }
 
   private:
+    // A full round's calibration is one scale for the whole image: right for the image's sum, but
+    // the spreads that share it out overstate the error where it is largest, where a top-up goes,
+    // and understate it elsewhere (on the thesis scenes at 400 x 300, 1.24-1.37 times the true
+    // variance over the top-up's pixels of Test1, Test2 and Test5, 0.75-0.96 over the others),
+    // and the scale itself is off by the calibration's noise (at 200 x 150 a 43-spp round of
+    // Test2 estimated 0.91 of its true RMSE). Once a top-up has taken off most of the error where
+    // it is largest, the estimate would be mostly what the scale says of the rest, and off by
+    // more than the round's own. A top-up of the last full round's count measures that round's
+    // true variance directly, from its pairs: on its pixels, and on `calibrating`, pixels picked
+    // at random among the others. Each set's sum over the last round's estimate there scales
+    // the rounds' estimate: on the top-up's pixels, and (from `calibrating`) everywhere else.
+    void recalibrate(const RenderResult& r, std::span<const std::uint32_t> topped,
+                     const Calibrating& calibrating) {
+        const auto measured = [&](std::span<const std::uint32_t> pixels,
+                                  std::span<const double> odds) {
+            double pairs = 0, estimated = 0;
+            for (std::size_t i = 0; i < pixels.size(); ++i) {
+                const double weight = odds.empty() ? 1 : 1 / odds[i];
+                const std::size_t p = pixels[i];
+                for (std::size_t c = 3 * p; c < 3 * p + 3; ++c) {
+                    // One render's variance, not the pair's mean's.
+                    pairs += weight * 2 * double(r.spread.rgb[c]);
+                    estimated += weight * last_variance_[c];
+                }
+            }
+            return estimated > 0 && std::isfinite(pairs) ? pairs / estimated : 1.0;
+        };
+        const double inside = measured(topped, {});
+        const double outside =
+            std::clamp(measured(calibrating.pixels, calibrating.odds), kLeastRescale, kMostRescale);
+        std::vector<bool> in(weights_.size(), false);
+        for (const std::uint32_t p : topped) in[p] = true;
+        for (std::size_t c = 0; c < variance_.size(); ++c) {
+            variance_[c] *= in[c / 3] ? inside : outside;
+            last_variance_[c] *= in[c / 3] ? inside : outside;
+        }
+    }
+
+    void combine(const RenderResult& r, int spp, std::span<const std::uint32_t> pixels) {
+        double before = 0, own = 0;
+        for (const std::uint32_t p : pixels) {
+            for (std::size_t c = 3 * std::size_t(p); c < 3 * std::size_t(p) + 3; ++c) {
+                before += variance_[c] / (weights_[p] * weights_[p]);
+                own += r.spread.rgb[c];
+            }
+        }
+        const bool estimated = own > 0 && before > 0 && std::isfinite(own);
+        const double predicted = top_up_variance_ratio(samples_, spp);
+        const double ratio = estimated ? before / own : 1 / predicted;
+        for (const std::uint32_t p : pixels) {
+            const double weight = ratio * weights_[p];
+            for (std::size_t c = 3 * std::size_t(p); c < 3 * std::size_t(p) + 3; ++c) {
+                const double variance =
+                    estimated ? double(r.spread.rgb[c])
+                              : predicted * variance_[c] / (weights_[p] * weights_[p]);
+                sum_[c] += weight * r.image.rgb[c];
+                variance_[c] += weight * weight * variance;
+            }
+            weights_[p] += weight;
+        }
+    }
+
     void count(const RenderResult& r) {
         stats_.rays += r.stats.rays;
         stats_.samples += r.stats.samples;
@@ -206,6 +282,9 @@ class Combination {
     int width_, height_;
     std::vector<double> sum_, variance_;  // per channel: sum of weight x value, weight^2 x variance
     std::vector<double> weights_;         // per pixel
+    int last_spp_ = 0;                    // the last full round's count
+    std::vector<double> last_variance_;   // and its estimated variance, per channel
+    bool recalibrated_ = false;
     int samples_ = 0;
     RenderStats stats_;
     double calibration_ = 0;   // camera samples the rounds' calibrations took
@@ -227,16 +306,22 @@ double predicted_seconds(const std::vector<ProgressiveRound>& rounds, int spp) {
     return line.setup + line.per_sample * spp * (1 + full_round_calibration(rounds));
 }
 
-std::optional<TopUp> plan_top_up(const Image& variance, int samples, double goal, int most_spp) {
+std::optional<TopUp> plan_top_up(const Image& variance, const Image& pair_variance, int spp,
+                                 double goal, std::optional<std::uint64_t> calibration_seed) {
     const auto width = static_cast<std::size_t>(variance.width);
     const auto height = static_cast<std::size_t>(variance.height);
     const std::size_t count = width * height;
-    if (count == 0 || samples < 1) return std::nullopt;
+    if (count < kMinTopUpPixels || spp < kMinRound || pair_variance.width != variance.width ||
+        pair_variance.height != variance.height) {
+        return std::nullopt;
+    }
+    const auto mean = [](const Image& image, std::size_t i) {
+        return (double(image.rgb[3 * i]) + image.rgb[3 * i + 1] + image.rgb[3 * i + 2]) / 3;
+    };
     std::vector<double> v(count);
     double total = 0;
     for (std::size_t i = 0; i < count; ++i) {
-        v[i] =
-            (double(variance.rgb[3 * i]) + variance.rgb[3 * i + 1] + variance.rgb[3 * i + 2]) / 3;
+        v[i] = mean(variance, i);
         total += v[i];
     }
     const double need = total - goal * goal * double(count);
@@ -256,27 +341,41 @@ std::optional<TopUp> plan_top_up(const Image& variance, int samples, double goal
     std::iota(order.begin(), order.end(), 0u);
     std::stable_sort(order.begin(), order.end(),
                      [&](std::uint32_t a, std::uint32_t b) { return around[a] > around[b]; });
-    // taken[k]: the variance of the first k pixels in that order.
-    std::vector<double> taken(count + 1, 0.0);
-    for (std::size_t k = 0; k < count; ++k) taken[k + 1] = taken[k] + v[order[k]];
-    std::optional<TopUp> best;
-    std::size_t best_pixels = 0;
-    for (int m = kMinRound; m <= std::min(samples, most_spp / 2); ++m) {
-        // Two estimates combined by inverse variance take v / (1 + ratio) off a pixel's v.
-        const double cut = 1 / (1 + top_up_variance_ratio(samples, m));
-        const auto reach = std::lower_bound(taken.begin(), taken.end(), need / cut);
-        if (reach == taken.end()) continue;
-        const auto pixels = std::max(kMinTopUpPixels, std::size_t(reach - taken.begin()));
-        if (pixels > count) continue;
-        if (!best || double(pixels) * m < double(best_pixels) * best->spp) {
-            best = TopUp{m, {}};
-            best_pixels = pixels;
+    // Two estimates combined by inverse variance take v / (1 + ratio) off a pixel's v.
+    // Two estimates combined by inverse variance take v^2 / (v + t) off a pixel's v.
+    std::size_t taken = 0;
+    for (double made = 0; taken < count && made < need; ++taken) {
+        const std::uint32_t p = order[taken];
+        const double t = mean(pair_variance, p);
+        made += v[p] + t > 0 ? v[p] * v[p] / (v[p] + t) : 0;
+    }
+    if (taken == count) return std::nullopt;
+    TopUp plan{spp, {}, {}, {}};
+    taken = std::max(taken, kMinTopUpPixels);
+    plan.pixels.assign(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(taken));
+    std::sort(plan.pixels.begin(), plan.pixels.end());
+    if (calibration_seed && taken < count) {
+        // Odds a quarter shared equally and the rest in proportion to the neighbours' largest
+        // variance (not the pixel's own: its pairs then stay unbiased), so that the pixels that
+        // hold the error are calibrated most often, weighted by 1 / odds.
+        std::vector<bool> topped(count, false);
+        for (const std::uint32_t p : plan.pixels) topped[p] = true;
+        double rest = 0;
+        for (std::size_t i = 0; i < count; ++i) rest += topped[i] ? 0 : around[i];
+        const double wanted = std::min(kTopUpCalibrationPixels, double(count) / 16);
+        const double others = double(count - taken);
+        for (std::uint32_t p = 0; p < count; ++p) {
+            if (topped[p]) continue;
+            const double share = rest > 0 ? 0.25 / others + 0.75 * around[p] / rest : 1 / others;
+            const double odds = std::min(1.0, wanted * share);
+            if (to_unit(hash_of(*calibration_seed, kTopUpCalibrationStream, std::uint64_t{p})) <
+                odds) {
+                plan.calibration.push_back(p);
+                plan.calibration_odds.push_back(odds);
+            }
         }
     }
-    if (!best) return std::nullopt;
-    best->pixels.assign(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(best_pixels));
-    std::sort(best->pixels.begin(), best->pixels.end());
-    return best;
+    return plan;
 }
 
 int pilot_block(int width, int height) {
@@ -391,7 +490,8 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
                     : 1;
     std::size_t full_rounds = 0;
     int spp = std::min(kFirstPilot, goal.max_samples);
-    std::vector<std::uint32_t> top_up;  // a top-up round's pixels
+    std::vector<std::uint32_t> top_up;  // a top-up round's pixels, on every process
+    std::optional<TopUp> planned;       // and what they are for, on the leader
     while (spp > 0) {
         scene.settings.samples = spp;
         if (out.combined) scene.settings.seed = round_seed(seed, full_rounds);
@@ -439,7 +539,8 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
                     if (!combination)
                         combination.emplace(job.render.image.width, job.render.image.height);
                     if (done.top_up()) {
-                        combination->add_top_up(job.render, spp, top_up);
+                        combination->add_top_up(job.render, spp, planned->pixels,
+                                                {planned->calibration, planned->calibration_odds});
                     } else {
                         combination->add(job.render, spp);
                     }
@@ -460,15 +561,27 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
                 // most of the shortfall, a top-up of those costs less than a whole round.
                 if (next > 0 && n.final && combination) {
                     const int total = total_samples(out.rounds);
-                    std::optional<TopUp> t =
-                        plan_top_up(out.job.render.spread, total, kSpareShare * *goal.target_error,
-                                    goal.max_samples - total);
+                    const auto last = std::find_if(out.rounds.rbegin(), out.rounds.rend(),
+                                                   [](const auto& r) { return r.full(); });
+                    // The first top-up also calibrates the pixels it leaves (Combination), picked
+                    // with the seed the top-up renders with.
+                    const bool first = std::none_of(out.rounds.begin(), out.rounds.end(),
+                                                    [](const auto& r) { return r.top_up(); });
+                    const int count = std::min(last->spp, (goal.max_samples - total) / 2);
+                    std::optional<TopUp> t = plan_top_up(
+                        out.job.render.spread, combination->pair_variance(count), count,
+                        kSpareShare * *goal.target_error,
+                        first ? std::optional(round_seed(seed, full_rounds + 1)) : std::nullopt);
                     if (t &&
                         t->cost(image_pixels) < next * (1 + full_round_calibration(out.rounds))) {
                         next = t->spp;
-                        next_pixels = std::move(t->pixels);
                         top_up_cost = t->cost(image_pixels);
                         full_next = n.spp;
+                        next_pixels = t->pixels;
+                        next_pixels.insert(next_pixels.end(), t->calibration.begin(),
+                                           t->calibration.end());
+                        std::sort(next_pixels.begin(), next_pixels.end());
+                        planned = std::move(t);
                     }
                 }
             } else if (spp < goal.max_samples) {
@@ -486,6 +599,7 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
                 if (!next_pixels.empty() &&
                     top_up_cost > fits * (1 + full_round_calibration(out.rounds))) {
                     next_pixels.clear();
+                    planned.reset();
                     next = full_next;
                 }
                 if (next_pixels.empty() && fits < next) {

@@ -116,6 +116,8 @@ bool RenderContext::renders(int x, int y) const {
 }
 
 SpreadKind RenderContext::spread_kind() const {
+    // A top-up's spreads are its pairs' own (render_again): the variance of their mean.
+    if (!top_up_.empty()) return SpreadKind::kIndependent;
     return sampler_->independent() ? SpreadKind::kIndependent : SpreadKind::kCalibrated;
 }
 
@@ -245,17 +247,16 @@ void RenderContext::calibrate(const Tile& tile, std::span<const Pixel> pixels,
 void RenderContext::render_again(const Tile& tile, std::span<const Pixel> pixels,
                                  std::span<const std::size_t> rendered, Scratch& scratch,
                                  TileBuffer& buffer) const {
-    const bool calibrated = spread_kind() == SpreadKind::kCalibrated;
     const auto width = static_cast<std::size_t>(tile.width());
     for (const std::size_t i : rendered) {
         const int x = static_cast<int>(i % width), y = static_cast<int>(i / width);
         const Pixel again =
             render_pixel(tile.x0 + x, tile.y0 + y, kCalibrationPath, scratch, buffer.rays);
-        if (calibrated) {
-            add_calibration(buffer.error_sums, pixels[i].value, again.value, pixels[i].spread, 1.0,
-                            again.samples);
-        }
-        buffer.pixels.set(x, y, (pixels[i].value + again.value) * 0.5);
+        const Color first = pixels[i].value;
+        const Color difference = first - again.value;
+        buffer.pixels.set(x, y, (first + again.value) * 0.5);
+        // (a - b)^2 / 4 has the variance of (a + b) / 2 as its expectation, whatever the pattern.
+        buffer.spread.set(x, y, difference * difference * 0.25);
         buffer.pixel_samples[i] += again.samples;
         buffer.samples += again.samples;
     }

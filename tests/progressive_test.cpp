@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <initializer_list>
+#include <iterator>
 #include <optional>
 #include <string>
 #include <vector>
@@ -357,21 +358,28 @@ Image variances(std::initializer_list<std::pair<int, double>> spikes) {
 double goal_short_by(const Image& v, double need) {
     double total = 0;
     for (const float x : v.rgb) total += x / 3.0;
-    return std::sqrt((total - need) / 256);
+    return std::sqrt((total - need) / (double(v.width) * v.height));
+}
+
+// `v` times `factor`: a top-up's predicted variance where it is proportional to the image's.
+Image times(Image v, float factor) {
+    for (float& x : v.rgb) x *= factor;
+    return v;
 }
 
 TEST(PlanTopUp, TakesPixelsByTheirNeighboursVarianceNotTheirOwn) {
     // One pixel, (8, 8), holds most of the variance; a shortfall of 1.47e-5 (14.7 quiet pixels).
     const int spike = 8 * 16 + 8;
     const Image v = variances({{spike, 1e-3}});
-    const auto plan = plan_top_up(v, 8, goal_short_by(v, 1.47e-5), 1000);
+    // A top-up of variance 4 v (two renders of 2 where the image has 8 along -3/4: (8/2)^1.5 / 2)
+    // takes v^2 / (v + 4 v) = v / 5 off a pixel: its 8 neighbours and then quiet pixels in index
+    // order, 74 in all (74 / 5 > 14.7 quiet pixels' worth).
+    const auto plan = plan_top_up(v, times(v, 4), 2, goal_short_by(v, 1.47e-5));
     ASSERT_TRUE(plan);
-    // Two renders of 2 samples take v / (1 + (2/8)^(-3/2) / 2) = v / 5 off a pixel: its 8
-    // neighbours and then quiet pixels in index order, 74 in all (74 / 5 > 14.7 quiet pixels'
-    // worth); 3 samples would take 64 pixels (the least) for 192 samples against 2 x 74 = 148.
     EXPECT_EQ(plan->spp, 2);
     ASSERT_EQ(plan->pixels.size(), 74u);
     EXPECT_TRUE(std::is_sorted(plan->pixels.begin(), plan->pixels.end()));
+    EXPECT_TRUE(plan->calibration.empty());  // none asked for
     const auto has = [&](int pixel) {
         return std::binary_search(plan->pixels.begin(), plan->pixels.end(),
                                   static_cast<std::uint32_t>(pixel));
@@ -381,30 +389,67 @@ TEST(PlanTopUp, TakesPixelsByTheirNeighboursVarianceNotTheirOwn) {
     EXPECT_FALSE(has(spike));
     EXPECT_TRUE(has(0));
     EXPECT_DOUBLE_EQ(plan->cost(256), 2.0 * 2 * 74 / 256);
+    // Two renders of the image's own count, v / 2, take two thirds of v off: 4.63e-5 takes 70
+    // quiet pixels.
+    EXPECT_EQ(plan_top_up(v, times(v, 0.5), 8, goal_short_by(v, 4.63e-5))->pixels.size(), 70u);
     // Two spikes side by side: each is the other's neighbour, so both are taken first.
     const Image pair = variances({{spike, 1e-3}, {spike + 1, 1e-3}});
-    const auto both = plan_top_up(pair, 8, goal_short_by(pair, 1e-3), 1000);
+    const auto both = plan_top_up(pair, times(pair, 0.5), 8, goal_short_by(pair, 1e-3));
     ASSERT_TRUE(both);
     EXPECT_TRUE(std::binary_search(both->pixels.begin(), both->pixels.end(), spike));
     EXPECT_TRUE(std::binary_search(both->pixels.begin(), both->pixels.end(), spike + 1));
 }
 
-TEST(PlanTopUp, AtLeast64PixelsWithinTheSamplesLeftOrNone) {
+TEST(PlanTopUp, AtLeast64PixelsOrNone) {
     const Image v = variances({{8 * 16 + 8, 1e-3}});
-    // A shortfall the spike's neighbours alone make up still takes 64 pixels, at the cheapest
-    // count that reaches with them: 3 (2 would need 75).
-    const auto least = plan_top_up(v, 8, goal_short_by(v, 1e-5), 1000);
+    const Image half = times(v, 0.5);
+    // A shortfall the spike's neighbours alone make up still takes 64 pixels.
+    const auto least = plan_top_up(v, half, 8, goal_short_by(v, 1e-6));
     ASSERT_TRUE(least);
     EXPECT_EQ(least->pixels.size(), kMinTopUpPixels);
-    // No more than the samples left (here 5: renders of 2 each), nor more than the image's
-    // samples so far.
-    const auto capped = plan_top_up(v, 8, goal_short_by(v, 1e-5), 5);
-    ASSERT_TRUE(capped);
-    EXPECT_EQ(capped->spp, 2);
-    EXPECT_EQ(plan_top_up(v, 8, goal_short_by(v, 1e-5), 3), std::nullopt);
-    // The goal met already, or out of reach even with every pixel topped up twice by 8: none.
-    EXPECT_EQ(plan_top_up(v, 8, 1, 1000), std::nullopt);
-    EXPECT_EQ(plan_top_up(v, 8, goal_short_by(v, 0.9e-3), 1000), std::nullopt);
+    // No top-up of 1 sample (no estimate), none when the goal is met, none out of reach even
+    // with every pixel topped up (here two thirds of the variance at most), none on an image of
+    // fewer than 64 pixels or with a prediction of another size.
+    EXPECT_EQ(plan_top_up(v, half, 1, goal_short_by(v, 1e-6)), std::nullopt);
+    EXPECT_EQ(plan_top_up(v, half, 8, 1), std::nullopt);
+    EXPECT_EQ(plan_top_up(v, half, 8, goal_short_by(v, 0.9e-3)), std::nullopt);
+    EXPECT_TRUE(plan_top_up(v, half, 8, goal_short_by(v, 0.8e-3)));
+    EXPECT_EQ(plan_top_up(Image(7, 9), Image(7, 9), 8, 0), std::nullopt);
+    EXPECT_EQ(plan_top_up(v, Image(16, 15), 8, goal_short_by(v, 1e-6)), std::nullopt);
+}
+
+TEST(PlanTopUp, CalibratesTheOtherPixelsAtRandomMostOftenNextToTheirVariance) {
+    // A variance rising to the right, a sixteenth of the 1,024 pixels asked for: 64 at most.
+    Image v(32, 32);
+    for (int y = 0; y < 32; ++y) {
+        for (int x = 0; x < 32; ++x) {
+            for (int c = 0; c < 3; ++c) v.rgb[3 * std::size_t(y * 32 + x) + c] = 1e-6f * (1 + x);
+        }
+    }
+    const double goal = goal_short_by(v, 1e-3);
+    const auto plan = plan_top_up(v, times(v, 0.5), 8, goal, 7);
+    ASSERT_TRUE(plan);
+    ASSERT_EQ(plan->calibration.size(), plan->calibration_odds.size());
+    EXPECT_TRUE(std::is_sorted(plan->calibration.begin(), plan->calibration.end()));
+    std::vector<std::uint32_t> both;
+    std::set_intersection(plan->pixels.begin(), plan->pixels.end(), plan->calibration.begin(),
+                          plan->calibration.end(), std::back_inserter(both));
+    EXPECT_TRUE(both.empty());
+    // About 64 (the odds sum to 64 over the others): a binomial's 5 sigma either way.
+    EXPECT_GT(plan->calibration.size(), 25u);
+    EXPECT_LT(plan->calibration.size(), 105u);
+    double left = 0, right = 0;
+    for (std::size_t i = 0; i < plan->calibration.size(); ++i) {
+        EXPECT_GT(plan->calibration_odds[i], 0);
+        EXPECT_LE(plan->calibration_odds[i], 1);
+        (plan->calibration[i] % 32 < 16 ? left : right) += 1;
+    }
+    EXPECT_GT(right, left);
+    // The same seed picks the same pixels; another, others.
+    EXPECT_EQ(plan_top_up(v, times(v, 0.5), 8, goal, 7)->calibration, plan->calibration);
+    EXPECT_NE(plan_top_up(v, times(v, 0.5), 8, goal, 8)->calibration, plan->calibration);
+    EXPECT_DOUBLE_EQ(plan->cost(1024),
+                     2.0 * 8 * double(plan->pixels.size() + plan->calibration.size()) / 1024);
 }
 
 TEST(RenderProgressively, ATopUpIsWeightedByTheRatioOfTheMeanVariancesOverItsPixels) {
@@ -418,7 +463,7 @@ TEST(RenderProgressively, ATopUpIsWeightedByTheRatioOfTheMeanVariancesOverItsPix
     RenderJobOptions options;
     options.threads = 2;
     const ProgressiveResult p = render_progressively(scene, options, goal);
-    // As GoalCli.TargetErrorGivesTheSameBitsForAnyThreadCount: 8, 15, then 2 x 7 on some pixels.
+    // As GoalCli.TargetErrorGivesTheSameBitsForAnyThreadCount: 8, 15, then 2 x 15 on some pixels.
     ASSERT_EQ(p.rounds.size(), 3u);
     ASSERT_TRUE(p.rounds[2].top_up());
     EXPECT_EQ(p.samples, 23);
@@ -441,35 +486,67 @@ TEST(RenderProgressively, ATopUpIsWeightedByTheRatioOfTheMeanVariancesOverItsPix
                       ((w0 + w1) * (w0 + w1));
         before.rgb[i] = static_cast<float>(variance[i]);
     }
-    const auto plan = plan_top_up(before, 23, 0.98 * 0.005, 1000 - 23);
+    // Of the last full round's count, predicted from its variance; it calibrates the rest.
+    Image pair(32, 24);
+    std::vector<double> last(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        last[i] = alone[1].stats.error.scale * alone[1].spread.rgb[i];
+        pair.rgb[i] = static_cast<float>(last[i] / 2);
+    }
+    const auto plan = plan_top_up(before, pair, 15, 0.98 * 0.005, round_seed(3, 2));
     ASSERT_TRUE(plan);
     EXPECT_EQ(plan->spp, p.rounds[2].spp);
-    EXPECT_DOUBLE_EQ(p.rounds[2].top_up_share, double(plan->pixels.size()) / (32 * 24));
-    // The top-up alone: its pixels, each the mean of two renders.
-    options.top_up = plan->pixels;
+    EXPECT_FALSE(plan->calibration.empty());
+    EXPECT_DOUBLE_EQ(p.rounds[2].top_up_share,
+                     double(plan->pixels.size() + plan->calibration.size()) / (32 * 24));
+    // The top-up alone: its pixels, each the mean of two renders, its spread their variance.
+    std::vector<std::uint32_t> all = plan->pixels;
+    all.insert(all.end(), plan->calibration.begin(), plan->calibration.end());
+    std::sort(all.begin(), all.end());
+    options.top_up = all;
     scene.settings.samples = plan->spp;
     scene.settings.seed = round_seed(3, 2);
     const RenderResult t = run_render_job(scene, options).render;
     ASSERT_TRUE(t.stats.error.available());
     EXPECT_EQ(p.rounds[2].error, t.stats.error.rmse);
-    double mean_before = 0, own = 0;
-    for (const std::uint32_t pixel : plan->pixels) {
-        for (std::size_t c = 3 * pixel; c < 3 * pixel + 3; ++c) {
-            mean_before += variance[c];
-            own += t.stats.error.scale / 2 * t.spread.rgb[c];
+    std::vector<int> set(n / 3, 0);  // 1: topped up, 2: calibrating
+    for (const std::uint32_t pixel : plan->pixels) set[pixel] = 1;
+    for (const std::uint32_t pixel : plan->calibration) set[pixel] = 2;
+    // The rounds' estimate recalibrated by what the pairs measure against the last round's
+    // estimate: on the top-up's pixels, and (from the calibrating ones, by 1 / their odds)
+    // everywhere else.
+    double pairs[3] = {}, estimated[3] = {};
+    for (std::size_t i = 0; i < plan->calibration.size(); ++i) {
+        for (std::size_t c = 3 * plan->calibration[i]; c < 3 * plan->calibration[i] + 3; ++c) {
+            pairs[2] += 2 * double(t.spread.rgb[c]) / plan->calibration_odds[i];
+            estimated[2] += last[c] / plan->calibration_odds[i];
         }
     }
-    const double ratio = mean_before / own;  // the top-up's weight over the rounds' before it
-    std::vector<bool> topped(n / 3, false);
-    for (const std::uint32_t pixel : plan->pixels) topped[pixel] = true;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (set[i / 3] == 1) {
+            pairs[1] += 2 * double(t.spread.rgb[i]);
+            estimated[1] += last[i];
+        }
+    }
+    const double inside = pairs[1] / estimated[1];
+    const double outside = std::clamp(pairs[2] / estimated[2], 0.25, 4.0);
+    EXPECT_NE(inside, 1.0);
+    EXPECT_NE(outside, 1.0);
+    double before_in[3] = {}, own[3] = {};
+    for (std::size_t i = 0; i < n; ++i) {
+        variance[i] *= set[i / 3] == 1 ? inside : outside;
+        before_in[set[i / 3]] += variance[i];
+        own[set[i / 3]] += t.spread.rgb[i];
+    }
+    // Each set's weight against the rounds before it: the ratio of their variances there.
+    const double ratio[3] = {0, before_in[1] / own[1], before_in[2] / own[2]};
     std::size_t differ = 0;
     double mse = 0;
     for (std::size_t i = 0; i < n; ++i) {
         double expected = mean[i], var = variance[i];
-        if (topped[i / 3]) {
-            expected = (mean[i] + ratio * t.image.rgb[i]) / (1 + ratio);
-            var = (var + ratio * ratio * t.stats.error.scale / 2 * t.spread.rgb[i]) /
-                  ((1 + ratio) * (1 + ratio));
+        if (const double r = ratio[set[i / 3]]; r > 0) {
+            expected = (mean[i] + r * t.image.rgb[i]) / (1 + r);
+            var = (var + r * r * t.spread.rgb[i]) / ((1 + r) * (1 + r));
         } else {
             EXPECT_EQ(t.image.rgb[i], 0.0f);  // not rendered
         }
@@ -481,9 +558,9 @@ TEST(RenderProgressively, ATopUpIsWeightedByTheRatioOfTheMeanVariancesOverItsPix
     ASSERT_TRUE(p.error);
     EXPECT_NEAR(*p.error, std::sqrt(mse / double(n)), 1e-6);
     EXPECT_LE(*p.error, 0.005);
-    // Every camera sample counted: the top-up's two renders of 7 on its pixels.
+    // Every camera sample counted: the top-up's two renders of 15 on its pixels.
     EXPECT_EQ(p.job.render.stats.samples,
-              alone[0].stats.samples + alone[1].stats.samples + 2 * 7 * plan->pixels.size());
+              alone[0].stats.samples + alone[1].stats.samples + 2 * 15 * all.size());
 }
 
 TEST_F(GoalCli, TimeLimitStopsByTheLimitWithThePlainRenderOfTheCountReached) {
@@ -536,7 +613,7 @@ TEST_F(GoalCli, TargetErrorIsMetAgainstAHighSampleReference) {
 
 TEST_F(GoalCli, TargetErrorGivesTheSameBitsForAnyThreadCount) {
     // A target three rounds reach, so the rounds' weights and sums count: 8, 15 and a top-up of
-    // 2 x 7 spp on the pixels around the most variance (a third full round of 7 spp before
+    // 2 x 15 spp on the pixels around the most variance (a third full round of 7 spp before
     // 2026-12-03).
     std::vector<std::string> images;
     std::optional<double> estimate;
@@ -544,7 +621,7 @@ TEST_F(GoalCli, TargetErrorGivesTheSameBitsForAnyThreadCount) {
         const Outcome r = run({"scene.xml", "--target-error", "0.005", "--width", "32", "--height",
                                "24", "-o", "t" + threads + ".pfm", "--threads", threads});
         ASSERT_EQ(r.status, 0) << r.err;
-        EXPECT_NE(r.err.find("after rounds of 8, 15 spp, a top-up of 2 x 7 spp on 8.98 % of the "
+        EXPECT_NE(r.err.find("after rounds of 8, 15 spp, a top-up of 2 x 15 spp on 14.32 % of the "
                              "pixels;"),
                   std::string::npos)
             << r.err;

@@ -110,9 +110,11 @@ for name in $scenes; do
             fixed_s=$(echo $fixed_times | median)
         fi
         goal_spp=$(json samples_per_pixel "$tmp/goal.json")
-        # A pilot of one pixel in b x b counts as spp/(b*b) samples per pixel of the image.
-        rounds=$(grep -o '{"spp": [0-9]*\(, "pilot_pixel_block": [0-9]*\)\?' "$tmp/goal.json" |
-            sed -e 's/{"spp": //' -e 's/, "pilot_pixel_block": \([0-9]*\)/\/(\1*\1)/' | paste -sd' ')
+        # A pilot of one pixel in b x b counts as spp/(b*b) samples per pixel of the image, a top-up
+        # of 2 x m samples on a share s of the pixels, shown as 2xm@s, as 2 m s.
+        rounds=$(grep -o '{"spp": [0-9]*\(, "pilot_pixel_block": [0-9]*\|, "top_up_share": [0-9.e-]*\)\?' "$tmp/goal.json" |
+            sed -e 's/{"spp": //' -e 's/, "pilot_pixel_block": \([0-9]*\)/\/(\1*\1)/' \
+                -e 's/^\([0-9]*\), "top_up_share": \(.*\)/2x\1@\2/' | paste -sd' ')
         estimated=$(json estimated_rmse "$tmp/goal.json")
         goal_true=$("$drt" compare "$tmp/goal.pfm" "$ref" | sed 's/rmse=\([^ ]*\).*/\1/')
         echo "$name,$target,$predicted,$goal_spp,$rounds,$goal_s,$(json seconds "$tmp/goal.json"),$estimated,$goal_true,$fixed,$fixed_s,$(json seconds "$tmp/fixed.json"),$(rmse_at "$fixed"),$(cut -d' ' -f1 /proc/loadavg)" >>"$csv"
@@ -121,12 +123,16 @@ for name in $scenes; do
 done
 
 # "goal samples / fixed": every round's samples against the fixed count's (free of the machine's
-# noise; a pilot of one pixel in b x b, shown as 8/(b*b), counts its share); "load" the 1-minute
+# noise; a pilot of one pixel in b x b, shown as 8/(b*b), counts its share, a top-up of 2 x m
+# samples on a share s of the pixels, shown as 2xm@s, 2 m s); "load" the 1-minute
 # load average when the case was timed.
 echo "| scene | E | predicted spp | predicted s | goal rounds (spp) | goal s | goal estimated RMSE | goal true RMSE | true / E | cheapest fixed spp (true RMSE ≤ E) | its s | goal samples / fixed | goal s / fixed s | load |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 tail -n +2 "$csv" | while IFS=, read -r name target pspp ps gspp rounds gs grs gest gtrue fspp fs frs ftrue load; do
-    samples=$(echo "scale=3; ${rounds// /+}" | bc)
+    samples=$(echo "$rounds" | tr ' ' '\n' | awk '
+        /@/ { split($0, t, /[x@]/); sum += 2 * t[2] * t[3]; next }
+        /\// { split($0, p, /[\/(*)]+/); sum += p[1] / (p[2] * p[3]); next }
+        { sum += $0 } END { printf "%.3f", sum }')
     walls=nan
     [ "$gs" = nan ] || walls=$(echo "$gs / $fs" | bc -l)
     printf '| %s | %s | %s | %.2f | %s | %.2f | %.5f | %.5f | %.2f | %s | %.2f | %.2f | %.2f | %s |\n' \

@@ -14,7 +14,10 @@
 // one it is the full render `--spp 8`, kept. The first full round is the plain render `--spp N`
 // of its count; where it meets the target alone, the image is that render's bit for bit.
 // Otherwise the image is no plain render's (a stratified pattern of N samples does not extend
-// one of fewer).
+// one of fewer). A near miss is made up, where it costs fewer samples than a full round, by a
+// top-up (plan_top_up): the last full round's count, twice, on the pixels next to the most
+// estimated variance only, with a seed of its own like a full round; the leader shares its
+// pixels with every process.
 //
 // To a time limit alone, each round is a complete render at one sample count that replaces the
 // last, so the image kept is bit-identical to the plain render `--spp N` of the count N it
@@ -147,32 +150,44 @@ struct NextRound {
 };
 NextRound next_round(const std::vector<ProgressiveRound>& rounds, double target, int max_samples);
 
-// A top-up round: `spp` samples in each of `pixels` (indices y * width + x, ascending), twice.
+// A top-up round: `spp` samples in each of `pixels` and `calibration` (indices y * width + x,
+// ascending), twice.
 struct TopUp {
     int spp = 0;
     std::vector<std::uint32_t> pixels;
+    // Pixels picked at random among the others, whose pairs measure their true error, and the
+    // odds each had.
+    std::vector<std::uint32_t> calibration;
+    std::vector<double> calibration_odds;
     // Its camera samples per pixel of the image.
     double cost(std::size_t image_pixels) const {
-        return 2.0 * spp * double(pixels.size()) / double(image_pixels);
+        return 2.0 * spp * double(pixels.size() + calibration.size()) / double(image_pixels);
     }
 };
+
+// A top-up's calibration takes this many pixels on average, at most a sixteenth of the image's.
+inline constexpr double kTopUpCalibrationPixels = 512;
 
 // A top-up round takes at least this many pixels: its own estimate, which weights it against the
 // rounds before, then rests on as many pairs (RenderContext).
 inline constexpr std::size_t kMinTopUpPixels = 64;
 
-// The cheapest top-up round predicted to bring an image of `samples` samples per pixel (full
-// rounds), whose estimated variances of the pixels' means are `variance` (per channel), to an
-// RMSE of `goal`, with at most `most_spp` samples in a pixel's two renders each; absent when
-// none does. The pixels are taken in order of the largest variance among their (up to) eight
-// neighbours, not their own: a pixel's own samples then do not decide whether it is topped up,
-// so the mean the rounds make of it stays unbiased (plan by its own variance and a pixel whose
-// samples happened to agree would keep its error). A pixel's two renders of m samples are
-// predicted to have variance v (n / m)^(3/2) / 2 against its variance v at n (along -3/4 below n,
-// as predict's smaller rounds; along -1/2 above), and to bring it to the two combined. The cost
-// is the camera samples, 2 m per pixel taken; of the counts from 2 to `samples` (or `most_spp`),
-// the cheapest.
-std::optional<TopUp> plan_top_up(const Image& variance, int samples, double goal, int most_spp);
+// The pixels a top-up round of `spp` samples, twice, needs to bring an image whose estimated
+// variances of the pixels' means are `variance` (per channel) to an RMSE of `goal`, where the
+// mean of a pixel's two renders is predicted to have the variance `pair_variance`; absent when
+// even every pixel does not, or the goal is met. The pixels are taken in order of the largest
+// variance among their (up to) eight neighbours, not their own: a pixel's own samples then do not
+// decide whether it is topped up, so the mean the rounds make of it stays unbiased (plan by its
+// own variance and a pixel whose samples happened to agree would keep its error). Combined with
+// the rounds by inverse variance, a pixel's v falls to v t / (v + t). At least kMinTopUpPixels.
+// With `calibration_seed`, also `calibration`: kTopUpCalibrationPixels of the
+// others on average (at most a sixteenth of the image), each picked by a hash of the seed and
+// the pixel with odds a quarter shared equally, the rest in proportion to its neighbours'
+// largest variance (at most 1). render_progressively takes the count of the last full round,
+// so that its first top-up recalibrates that round's estimate (progressive.cpp, Combination).
+std::optional<TopUp> plan_top_up(const Image& variance, const Image& pair_variance, int spp,
+                                 double goal,
+                                 std::optional<std::uint64_t> calibration_seed = std::nullopt);
 
 struct ProgressiveResult {
     RenderJobResult job;    // the image kept: the rounds combined, or a time limit's last round

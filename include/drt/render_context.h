@@ -38,8 +38,9 @@ class RenderContext {
     // image (see renders()) and leaves the others 0: a pilot that measures the whole image's
     // error per pixel at a fraction of its cost (progressive.h). `top_up`, when not empty, the
     // indices y * width + x of the only pixels rendered (a top-up round, progressive.h): each
-    // twice, with independent patterns, and the two averaged; for a stratified or Sobol sampler
-    // every pair's difference calibrates the estimate, which is then the top-up pixels' own.
+    // twice, with independent patterns, and the two averaged; a pixel's spread is then a quarter
+    // of the pair's squared difference, whose expectation is the variance of their mean whatever
+    // the sampler (spread_kind() kIndependent): the estimate is the top-up pixels' own.
     RenderContext(const Scene& scene, std::optional<AdaptiveSampling> adaptive,
                   bool estimate_error = true, int pixel_block = 1,
                   std::span<const std::uint32_t> top_up = {});
@@ -116,7 +117,7 @@ class RenderContext {
                    std::span<const std::size_t> rendered, Scratch& scratch,
                    TileBuffer& buffer) const;
     // A top-up's second render of each of the tile's `rendered` pixels: averaged into the
-    // buffer's pixels, and their difference added to its error sums (for a calibrated sampler).
+    // buffer's pixels, the pair's difference its spread.
     void render_again(const Tile& tile, std::span<const Pixel> pixels,
                       std::span<const std::size_t> rendered, Scratch& scratch,
                       TileBuffer& buffer) const;
