@@ -341,15 +341,15 @@ std::optional<TopUp> plan_top_up(const Image& variance, const Image& pair_varian
     std::iota(order.begin(), order.end(), 0u);
     std::stable_sort(order.begin(), order.end(),
                      [&](std::uint32_t a, std::uint32_t b) { return around[a] > around[b]; });
-    // Two estimates combined by inverse variance take v / (1 + ratio) off a pixel's v.
     // Two estimates combined by inverse variance take v^2 / (v + t) off a pixel's v.
     std::size_t taken = 0;
-    for (double made = 0; taken < count && made < need; ++taken) {
+    double made = 0;
+    for (; taken < count && made < need; ++taken) {
         const std::uint32_t p = order[taken];
         const double t = mean(pair_variance, p);
         made += v[p] + t > 0 ? v[p] * v[p] / (v[p] + t) : 0;
     }
-    if (taken == count) return std::nullopt;
+    if (made < need) return std::nullopt;
     TopUp plan{spp, {}, {}, {}};
     taken = std::max(taken, kMinTopUpPixels);
     plan.pixels.assign(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(taken));
@@ -563,11 +563,12 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
                     const int total = total_samples(out.rounds);
                     const auto last = std::find_if(out.rounds.rbegin(), out.rounds.rend(),
                                                    [](const auto& r) { return r.full(); });
-                    // The first top-up also calibrates the pixels it leaves (Combination), picked
-                    // with the seed the top-up renders with.
-                    const bool first = std::none_of(out.rounds.begin(), out.rounds.end(),
-                                                    [](const auto& r) { return r.top_up(); });
                     const int count = std::min(last->spp, (goal.max_samples - total) / 2);
+                    // The first top-up of the last round's count also calibrates the pixels it
+                    // leaves (Combination), picked with the seed the top-up renders with.
+                    const bool first = count == last->spp &&
+                                       std::none_of(out.rounds.begin(), out.rounds.end(),
+                                                    [](const auto& r) { return r.top_up(); });
                     std::optional<TopUp> t = plan_top_up(
                         out.job.render.spread, combination->pair_variance(count), count,
                         kSpareShare * *goal.target_error,
