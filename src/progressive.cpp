@@ -32,20 +32,20 @@ constexpr int kMinSlopeSpan = 3;
 constexpr double kIndependentSlope = -0.5;
 // The slope a round smaller than the largest is extrapolated along (toward fewer samples): the
 // true RMSE of the thesis scenes' stratified renders at --scale 0.1 falls along -0.60 (Test2)
-// to -0.83 (Test4) from 2 to 8 spp, where these top-up rounds lie; -1, taken before, assumed a
+// to -0.83 (Test4) from 2 to 8 spp, where these small rounds lie; -1, taken before, assumed a
 // steeper rise than any scene's and so sized them larger than needed (docs/accuracy-history.md).
 constexpr double kSmallRoundSlope = -0.75;
 // The first full round after a pilot of some pixels aims at this share of the target, and toward
 // more samples than the pilot's along kPilotSlope (toward fewer along kSmallRoundSlope, as any
 // smaller round): the pilot's estimate scatters a little more than a full round's (0.82-1.14 of
 // the true RMSE on Test2, Test4 and Test5 at --scale 0.25 with 1,200 pixels and 20 seeds, the
-// full render's own 0.86-1.12), and a full round that falls short is topped up by a second
-// pattern, whose split costs the steep scenes 20-50 % where the margin costs about 6 %. -0.8 is
+// full render's own 0.86-1.12), and a full round that falls short is made up by a second
+// pattern, now mostly a top-up of some pixels (plan_top_up), which costs little. -0.8 is
 // steeper than the thesis scenes' estimated slopes from 8 to 32 spp at 200 x 150 and 400 x 300
 // (-0.51 to -0.75), so the round errs on the short side: along -0.65 or -0.7 the rounds that
-// land overshoot by about what the top-ups they spare cost, along -0.9 more of them miss (the
-// samples' geometric means within 4 % of -0.8's). Measured against other shares, slopes and
-// pilot sizes in docs/accuracy-history.md.
+// land overshoot by about what the second rounds they spared cost, along -0.9 more of them miss
+// (the samples' geometric means within 4 % of -0.8's; measured before the top-ups). Measured
+// against other shares, slopes and pilot sizes in docs/accuracy-history.md.
 constexpr double kPilotSpareShare = 0.95;
 constexpr double kPilotSlope = -0.8;
 // Of the time left, what a round may be predicted to take: the rest absorbs the prediction's

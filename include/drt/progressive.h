@@ -120,7 +120,7 @@ struct Prediction {
 // most a third of its count (held between `steepest` and -1/4: rounds are noisy); without such a
 // round the slope is `steepest` itself (-1 by default: the count errs on the short side, since a
 // shortfall costs only one small round more; next_round passes -1/2 after a final round missed).
-// A round smaller than that one's (a top-up after a near miss) is extrapolated along -3/4
+// A round smaller than that one's (after a near miss) is extrapolated along -3/4
 // instead, whatever the measured slope: between 2 and 8 spp the thesis scenes' stratified errors
 // fall along -0.6 to -0.83, and a pattern's gain over independent samples is smallest at few
 // samples. With round_weight's weights the combined error c' of one more round of error e is
@@ -209,7 +209,8 @@ inline constexpr int kFinalStep = 12;
 inline constexpr double kSpareShare = 0.98;
 
 // Collective under MPI. A round at kFirstPilot, then for a target error the rounds next_round
-// sizes (combined; also under a time limit, which may end them early), for a time budget alone
+// sizes, or a top-up (plan_top_up) where it costs fewer samples than a round meant as the last
+// (combined; also under a time limit, which may end them early), for a time budget alone
 // the largest predicted to fit (with a tenth to spare), until the goal is met, the budget is spent
 // or max_samples reached; with goal.pilots_only, a target error stops before its final round
 // (what drt info --target-error renders). A round still running when the budget runs out is
