@@ -175,23 +175,29 @@ std::string goal_summary(const std::string& name, const ProgressiveResult& p, co
     std::ostringstream line;
     line << "drt: " << name << ": " << p.samples << " spp after ";
     const char* separator = "rounds of ";
-    std::ostringstream top_ups;
+    // In the order they ran: "rounds of 8, 18 spp", then any top-up, and a full round after a
+    // top-up (a time limit's cut) as "a round of N spp".
+    bool listing = false;  // inside the list of full rounds, " spp" still to come
+    bool topped = false;
     for (const ProgressiveRound& r : p.rounds) {
-        if (r.top_up()) {
-            top_ups << ", a top-up of 2 x " << r.spp << " spp on " << std::fixed
-                    << std::setprecision(2) << 100 * r.top_up_share << std::defaultfloat
-                    << " % of the pixels";
-            continue;
-        }
-        if (!r.full()) {
+        if (!r.full() && !r.top_up()) {
             line << "a pilot of " << r.spp << " spp on 1 pixel in " << r.pixel_block * r.pixel_block
                  << ", ";
-            continue;
+        } else if (r.top_up()) {
+            line << (listing ? " spp" : "") << ", a top-up of 2 x " << r.spp << " spp on "
+                 << std::fixed << std::setprecision(2) << 100 * r.top_up_share << std::defaultfloat
+                 << " % of the pixels";
+            listing = false;
+            topped = true;
+        } else if (topped) {
+            line << ", a round of " << r.spp << " spp";
+        } else {
+            line << separator << r.spp;
+            separator = ", ";
+            listing = true;
         }
-        line << separator << r.spp;
-        separator = ", ";
     }
-    line << " spp" << top_ups.str() << "; estimated rmse "
+    line << (listing ? " spp" : "") << "; estimated rmse "
          << (p.error ? short_number(*p.error) : std::string("n/a"));
     if (goal.target_error) {
         line << " (target " << short_number(*goal.target_error)

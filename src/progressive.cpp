@@ -307,7 +307,8 @@ double predicted_seconds(const std::vector<ProgressiveRound>& rounds, int spp) {
 }
 
 std::optional<TopUp> plan_top_up(const Image& variance, const Image& pair_variance, int spp,
-                                 double goal, std::optional<std::uint64_t> calibration_seed) {
+                                 double goal, std::optional<std::uint64_t> calibration_seed,
+                                 std::size_t most_pixels) {
     const auto width = static_cast<std::size_t>(variance.width);
     const auto height = static_cast<std::size_t>(variance.height);
     const std::size_t count = width * height;
@@ -344,12 +345,13 @@ std::optional<TopUp> plan_top_up(const Image& variance, const Image& pair_varian
     // Two estimates combined by inverse variance take v^2 / (v + t) off a pixel's v.
     std::size_t taken = 0;
     double made = 0;
-    for (; taken < count && made < need; ++taken) {
+    const std::size_t most = std::min(count, most_pixels);
+    for (; taken < most && made < need; ++taken) {
         const std::uint32_t p = order[taken];
         const double t = mean(pair_variance, p);
         made += v[p] + t > 0 ? v[p] * v[p] / (v[p] + t) : 0;
     }
-    if (made < need) return std::nullopt;
+    if (made < need && (taken == count || taken < kMinTopUpPixels)) return std::nullopt;
     TopUp plan{spp, {}, {}, {}};
     taken = std::max(taken, kMinTopUpPixels);
     plan.pixels.assign(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(taken));
@@ -515,7 +517,8 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
         RenderJobResult job = run_render_job(scene, run);
         alarm.reset();
         int next = 0;
-        std::vector<std::uint32_t> next_pixels;  // the next round's, when a top-up
+        std::vector<std::uint32_t> next_pixels;     // the next round's, when a top-up
+        std::optional<std::uint64_t> planned_seed;  // its calibrating pixels' seed
         double top_up_cost = 0;
         int full_next = 0;  // the full round a top-up replaces
         if (!leader) {
@@ -569,10 +572,11 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
                     const bool first = count == last->spp &&
                                        std::none_of(out.rounds.begin(), out.rounds.end(),
                                                     [](const auto& r) { return r.top_up(); });
-                    std::optional<TopUp> t = plan_top_up(
-                        out.job.render.spread, combination->pair_variance(count), count,
-                        kSpareShare * *goal.target_error,
-                        first ? std::optional(round_seed(seed, full_rounds + 1)) : std::nullopt);
+                    planned_seed =
+                        first ? std::optional(round_seed(seed, full_rounds + 1)) : std::nullopt;
+                    std::optional<TopUp> t =
+                        plan_top_up(out.job.render.spread, combination->pair_variance(count), count,
+                                    kSpareShare * *goal.target_error, planned_seed);
                     if (t &&
                         t->cost(image_pixels) < next * (1 + full_round_calibration(out.rounds))) {
                         next = t->spp;
@@ -597,11 +601,27 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
                 // one a quarter larger is worth its time. After a pilot, the first full round
                 // whatever the time: the image.
                 const double least = out.combined ? kMinRound : 1.25 * spp;
-                if (!next_pixels.empty() &&
-                    top_up_cost > fits * (1 + full_round_calibration(out.rounds))) {
+                // A top-up that does not fit takes the pixels that do, first in its order, if
+                // they are enough; otherwise a full round as large as fits.
+                const double affordable = fits * (1 + full_round_calibration(out.rounds));
+                if (!next_pixels.empty() && top_up_cost > affordable) {
+                    const double pixels = affordable * double(image_pixels) / (2.0 * next) -
+                                          double(planned->calibration.size());
+                    planned =
+                        pixels >= double(kMinTopUpPixels)
+                            ? plan_top_up(out.job.render.spread, combination->pair_variance(next),
+                                          next, kSpareShare * *goal.target_error, planned_seed,
+                                          static_cast<std::size_t>(pixels))
+                            : std::nullopt;
                     next_pixels.clear();
-                    planned.reset();
-                    next = full_next;
+                    if (planned) {
+                        next_pixels = planned->pixels;
+                        next_pixels.insert(next_pixels.end(), planned->calibration.begin(),
+                                           planned->calibration.end());
+                        std::sort(next_pixels.begin(), next_pixels.end());
+                    } else {
+                        next = full_next;
+                    }
                 }
                 if (next_pixels.empty() && fits < next) {
                     next = fits >= least ? static_cast<int>(fits) : 0;

@@ -416,6 +416,18 @@ TEST(PlanTopUp, AtLeast64PixelsOrNone) {
     EXPECT_TRUE(plan_top_up(v, half, 8, goal_short_by(v, 0.8e-3)));
     EXPECT_EQ(plan_top_up(Image(7, 9), Image(7, 9), 8, 0), std::nullopt);
     EXPECT_EQ(plan_top_up(v, Image(16, 15), 8, goal_short_by(v, 1e-6)), std::nullopt);
+    // Cut to what the time left pays for: the first pixels in order, short of the goal, but
+    // never fewer than 64.
+    const double goal = goal_short_by(v, 4.63e-5);  // 70 pixels (above)
+    const auto cut = plan_top_up(v, half, 8, goal, std::nullopt, 66);
+    ASSERT_TRUE(cut);
+    EXPECT_EQ(cut->pixels.size(), 66u);
+    const auto whole = plan_top_up(v, half, 8, goal, std::nullopt, 1000);
+    ASSERT_TRUE(whole);
+    EXPECT_EQ(whole->pixels.size(), 70u);
+    EXPECT_TRUE(std::includes(whole->pixels.begin(), whole->pixels.end(), cut->pixels.begin(),
+                              cut->pixels.end()));
+    EXPECT_EQ(plan_top_up(v, half, 8, goal, std::nullopt, 63), std::nullopt);
 }
 
 TEST(PlanTopUp, CalibratesTheOtherPixelsAtRandomMostOftenNextToTheirVariance) {

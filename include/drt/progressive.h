@@ -28,6 +28,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -185,9 +186,12 @@ inline constexpr std::size_t kMinTopUpPixels = 64;
 // the pixel with odds a quarter shared equally, the rest in proportion to its neighbours'
 // largest variance (at most 1). render_progressively takes the count of the last full round,
 // so that its first top-up recalibrates that round's estimate (progressive.cpp, Combination).
+// With `most_pixels` (at least kMinTopUpPixels), at most that many, the first in that order,
+// even where they fall short of `goal` (a top-up cut to the time left).
 std::optional<TopUp> plan_top_up(const Image& variance, const Image& pair_variance, int spp,
                                  double goal,
-                                 std::optional<std::uint64_t> calibration_seed = std::nullopt);
+                                 std::optional<std::uint64_t> calibration_seed = std::nullopt,
+                                 std::size_t most_pixels = std::numeric_limits<std::size_t>::max());
 
 struct ProgressiveResult {
     RenderJobResult job;    // the image kept: the rounds combined, or a time limit's last round
