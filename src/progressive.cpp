@@ -174,13 +174,12 @@ class Combination {
     }
 
     // The estimated variance of the mean of two renders of `spp` samples, per pixel and channel:
-    // half the last full round's (recalibrated), along kSmallRoundSlope below its count.
+    // the last full round's (recalibrated) times top_up_variance_ratio.
     Image pair_variance(int spp) const {
         Image out(width_, height_);
-        const double factor =
-            spp < last_spp_ ? std::pow(double(spp) / last_spp_, 2 * kSmallRoundSlope) : 1.0;
+        const double ratio = top_up_variance_ratio(last_spp_, spp);
         for (std::size_t i = 0; i < last_variance_.size(); ++i) {
-            out.rgb[i] = static_cast<float>(last_variance_[i] * factor / 2);
+            out.rgb[i] = static_cast<float>(last_variance_[i] * ratio);
         }
         return out;
     }
@@ -304,6 +303,13 @@ double predicted_seconds(const std::vector<ProgressiveRound>& rounds, int spp) {
     if (rounds.empty()) return 0;
     const Line line = time_line(rounds);
     return line.setup + line.per_sample * spp * (1 + full_round_calibration(rounds));
+}
+
+std::vector<std::uint32_t> TopUp::rendered() const {
+    std::vector<std::uint32_t> all = pixels;
+    all.insert(all.end(), calibration.begin(), calibration.end());
+    std::sort(all.begin(), all.end());
+    return all;
 }
 
 std::optional<TopUp> plan_top_up(const Image& variance, const Image& pair_variance, int spp,
@@ -517,10 +523,9 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
         RenderJobResult job = run_render_job(scene, run);
         alarm.reset();
         int next = 0;
-        std::vector<std::uint32_t> next_pixels;     // the next round's, when a top-up
+        std::optional<TopUp> next_plan;             // the next round's, when a top-up
         std::optional<std::uint64_t> planned_seed;  // its calibrating pixels' seed
-        double top_up_cost = 0;
-        int full_next = 0;  // the full round a top-up replaces
+        int full_next = 0;                          // the full round a top-up replaces
         if (!leader) {
             if (block == 1) out.job = std::move(job);
         } else if (!job.complete()) {
@@ -580,13 +585,8 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
                     if (t &&
                         t->cost(image_pixels) < next * (1 + full_round_calibration(out.rounds))) {
                         next = t->spp;
-                        top_up_cost = t->cost(image_pixels);
                         full_next = n.spp;
-                        next_pixels = t->pixels;
-                        next_pixels.insert(next_pixels.end(), t->calibration.begin(),
-                                           t->calibration.end());
-                        std::sort(next_pixels.begin(), next_pixels.end());
-                        planned = std::move(t);
+                        next_plan = std::move(t);
                     }
                 }
             } else if (spp < goal.max_samples) {
@@ -604,34 +604,27 @@ ProgressiveResult render_progressively(Scene& scene, const RenderJobOptions& opt
                 // A top-up that does not fit takes the pixels that do, first in its order, if
                 // they are enough; otherwise a full round as large as fits.
                 const double affordable = fits * (1 + full_round_calibration(out.rounds));
-                if (!next_pixels.empty() && top_up_cost > affordable) {
+                if (next_plan && next_plan->cost(image_pixels) > affordable) {
                     const double pixels = affordable * double(image_pixels) / (2.0 * next) -
-                                          double(planned->calibration.size());
-                    planned =
+                                          double(next_plan->calibration.size());
+                    next_plan =
                         pixels >= double(kMinTopUpPixels)
                             ? plan_top_up(out.job.render.spread, combination->pair_variance(next),
                                           next, kSpareShare * *goal.target_error, planned_seed,
                                           static_cast<std::size_t>(pixels))
                             : std::nullopt;
-                    next_pixels.clear();
-                    if (planned) {
-                        next_pixels = planned->pixels;
-                        next_pixels.insert(next_pixels.end(), planned->calibration.begin(),
-                                           planned->calibration.end());
-                        std::sort(next_pixels.begin(), next_pixels.end());
-                    } else {
-                        next = full_next;
-                    }
+                    if (!next_plan) next = full_next;
                 }
-                if (next_pixels.empty() && fits < next) {
+                if (!next_plan && fits < next) {
                     next = fits >= least ? static_cast<int>(fits) : 0;
                 }
                 if (done.pixel_block > 1) next = std::max(next, kMinRound);
             }
         }
         spp = options.mpi ? options.mpi->leaders(next) : next;
-        top_up =
-            options.mpi ? options.mpi->leaders(std::move(next_pixels)) : std::move(next_pixels);
+        planned = std::move(next_plan);
+        top_up = planned ? planned->rendered() : std::vector<std::uint32_t>{};
+        if (options.mpi) top_up = options.mpi->leaders(std::move(top_up));
         if (block == 1) ++full_rounds;
         block = 1;
     }

@@ -160,6 +160,8 @@ struct TopUp {
     // odds each had.
     std::vector<std::uint32_t> calibration;
     std::vector<double> calibration_odds;
+    // What the round renders: `pixels` and `calibration` together, ascending.
+    std::vector<std::uint32_t> rendered() const;
     // Its camera samples per pixel of the image.
     double cost(std::size_t image_pixels) const {
         return 2.0 * spp * double(pixels.size() + calibration.size()) / double(image_pixels);
