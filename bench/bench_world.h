@@ -7,11 +7,11 @@
 #include <memory>
 #include <vector>
 
-#include "drt/material.h"
-#include "drt/object.h"
-#include "drt/ray.h"
-#include "drt/rng.h"
-#include "drt/sphere.h"
+#include "drt/geometry/object.h"
+#include "drt/geometry/sphere.h"
+#include "drt/shading/material.h"
+#include "drt/util/ray.h"
+#include "drt/util/rng.h"
 
 namespace drt::bench {
 

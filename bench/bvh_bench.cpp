@@ -3,9 +3,9 @@
 #include <benchmark/benchmark.h>
 
 #include "bench_world.h"
-#include "drt/bvh.h"
-#include "drt/occluders.h"
-#include "drt/plane.h"
+#include "drt/accel/bvh.h"
+#include "drt/accel/occluders.h"
+#include "drt/geometry/plane.h"
 
 namespace drt::bench {
 namespace {

@@ -6,9 +6,9 @@
 #include <vector>
 
 #include "bench_world.h"
-#include "drt/light.h"
-#include "drt/plane.h"
-#include "drt/sampler.h"
+#include "drt/geometry/plane.h"
+#include "drt/sampling/sampler.h"
+#include "drt/scene/light.h"
 
 namespace drt::bench {
 namespace {

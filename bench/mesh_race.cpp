@@ -32,13 +32,13 @@
 #include <thread>
 #include <vector>
 
-#include "drt/bvh.h"
-#include "drt/integrator.h"
-#include "drt/light.h"
-#include "drt/mesh.h"
-#include "drt/obj_reader.h"
-#include "drt/rng.h"
-#include "drt/scene_loader.h"
+#include "drt/accel/bvh.h"
+#include "drt/accel/mesh.h"
+#include "drt/io/obj_reader.h"
+#include "drt/render/integrator.h"
+#include "drt/scene/light.h"
+#include "drt/scene/scene_loader.h"
+#include "drt/util/rng.h"
 
 namespace {
 

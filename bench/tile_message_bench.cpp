@@ -8,8 +8,8 @@
 #include <optional>
 #include <vector>
 
-#include "drt/checkpoint.h"
-#include "drt/tile.h"
+#include "drt/job/checkpoint.h"
+#include "drt/render/tile.h"
 
 namespace drt::bench {
 namespace {

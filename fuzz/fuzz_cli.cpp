@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "drt/cli.h"
-#include "drt/image.h"
+#include "drt/cli/cli.h"
+#include "drt/io/image.h"
 
 namespace {
 

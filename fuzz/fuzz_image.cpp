@@ -8,8 +8,8 @@
 #include <fstream>
 #include <string>
 
-#include "drt/compare.h"
-#include "drt/image.h"
+#include "drt/io/compare.h"
+#include "drt/io/image.h"
 
 namespace {
 

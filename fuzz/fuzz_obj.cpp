@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "drt/obj_reader.h"
+#include "drt/io/obj_reader.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     try {

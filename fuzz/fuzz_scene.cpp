@@ -6,9 +6,10 @@
 #include <cstdint>
 #include <string_view>
 
-#include "drt/limits.h"
-#include "drt/renderer.h"
-#include "drt/scene_loader.h"
+#include "drt/render/renderer.h"
+#include "drt/scene/render_limits.h"
+#include "drt/scene/scene_loader.h"
+#include "drt/util/limits.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     drt::LoadedScene loaded;

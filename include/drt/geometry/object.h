@@ -1,0 +1,126 @@
+// The abstract scene object: something a ray can hit, made of a material, optionally textured
+// and bump-mapped. An object hands the BVH its geometry as typed shapes (spheres, planes), which
+// the BVH copies into flat arrays and tests inline; the object itself is asked again only about
+// the one hit a ray keeps, for its surface.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "drt/geometry/motion.h"
+#include "drt/shading/material.h"
+#include "drt/shading/texture.h"
+#include "drt/util/color.h"
+#include "drt/util/math.h"
+#include "drt/util/ray.h"
+
+namespace drt {
+
+class Object;
+
+// Where a ray met a primitive (pbrt-v4's and Mitsuba 3's preliminary intersection): what the
+// intersection test knows, from which Object::surface_at works out the rest for the one hit a
+// ray keeps.
+struct Hit {
+    double t = kInfinity;            // ray parameter
+    const Object* object = nullptr;  // the object hit
+    std::uint32_t primitive = 0;     // which of the object's shapes (a mesh's triangle number)
+    // The primitive's own coordinates of the hit where its test yields them (a triangle's
+    // barycentrics b1, b2, from which a mesh interpolates normals). Spheres and planes leave
+    // them 0: their surface follows exactly from the point ray.at(t) projected onto them.
+    Vec2 uv;
+};
+
+// What the integrator needs to know about the point a ray hit.
+struct SurfaceHit {
+    Vec3 point;           // on the surface, refined after intersection
+    Vec3 normal;          // geometric, unit, pointing out of the object
+    Vec3 shading_normal;  // normal after bump mapping, same side as `normal`
+    Color kd;             // diffuse colour after texturing
+    // Where shadow rays leave, and the normal that says which lights are above the surface:
+    // `point` and `normal`, except on a smooth mesh. There the lights a shading normal sees may
+    // be below the flat facet, and shadow rays from the facet would meet the facet's neighbours:
+    // black facets along the shadow terminator. Shadow rays leave instead from the point lifted
+    // onto the curved surface the vertex normals describe (Hanika, "Hacking the shadow
+    // terminator", Ray Tracing Gems II, 2021), and the interpolated normal decides which lights
+    // are above.
+    Vec3 light_point, light_normal;
+};
+
+// A sphere as the BVH stores it: the BVH splits its path into one piece per segment, each bounded
+// over that segment's time span only.
+struct SphereShape {
+    const MotionPath* path;  // owned by the object, which outlives the BVH
+    double radius;
+};
+struct PlaneShape {
+    Vec3 point, normal;  // normal of unit length
+};
+class TriangleMesh;
+// A triangle mesh enters the BVH whole (one piece per segment of its path), and the BVH's leaf
+// test runs the mesh's own hierarchy on the ray moved into the mesh's coordinates.
+struct MeshShape {
+    const TriangleMesh* mesh;  // owned by the object, which outlives the BVH
+    const MotionPath* path;    // where the mesh's own origin is at each time
+};
+// An object's geometry in the typed forms the BVH tests inline (no virtual call and no pointer
+// chase per ray). A new kind of primitive gets its array here, its Kind and case in the BVH's
+// one leaf test (Bvh::hit) and its bounds in the BVH's build; Hit::primitive is its index in
+// its array.
+struct Shapes {
+    std::vector<SphereShape> spheres;
+    std::vector<PlaneShape> planes;  // unbounded: tested outside the tree
+    std::vector<MeshShape> meshes = {};
+};
+
+// How an object's surface departs from its material's plain colour.
+struct SurfaceDetail {
+    std::shared_ptr<const Texture> texture;  // replaces the material's kd; null = none
+    std::optional<BumpMap> bump;
+};
+
+class Object {
+  public:
+    Object(const Material& material, SurfaceDetail detail)
+        : material_(&material), detail_(std::move(detail)) {}
+    virtual ~Object() = default;
+    Object(const Object&) = delete;
+    Object& operator=(const Object&) = delete;
+
+    // The nearest intersection inside `range`, if any, tested on this object alone (the BVH
+    // tests the same shapes with the same arithmetic and must find the same hit).
+    virtual std::optional<Hit> intersect(const Ray& ray, Interval range) const = 0;
+    virtual Shapes shapes() const = 0;
+
+    const Material& material() const { return *material_; }
+    const SurfaceDetail& detail() const { return detail_; }
+    // Shutter time at which the object's motion path ends; 0 for an object that stays put.
+    virtual double motion_end() const { return 0; }
+    bool moves() const { return motion_end() > 0; }
+
+    // Surface information at a hit on this object by `ray`.
+    SurfaceHit surface_at(const Ray& ray, const Hit& hit) const;
+
+  protected:
+    // Where a texture and a bump map are evaluated at a hit: coordinates fixed to a moving
+    // object for the texture, world-aligned ones for bump noise.
+    struct SurfaceCoordinates {
+        Vec3 texture_point, bump_point;
+    };
+    // Where on the surface a hit lies, before texture and bump, written into `surface`: the
+    // exact point on the surface nearest to ray.at(t) (which removes most of the rounding error
+    // a hit point picks up), the geometric normal (unit, outward), the shading normal before
+    // bump mapping (the geometric one, or one a mesh interpolates over a triangle), and where
+    // shadow rays leave. Written in place rather than returned: copying a returned record cost
+    // 2 % of a render in stalled loads (docs/performance.md, fifth round).
+    virtual SurfaceCoordinates locate(const Ray& ray, const Hit& hit,
+                                      SurfaceHit& surface) const = 0;
+
+  private:
+    const Material* material_;
+    SurfaceDetail detail_;
+};
+
+}  // namespace drt

@@ -1,0 +1,49 @@
+// Reads the subset of Wavefront OBJ that ../shared/spec/scene-format.md ("Triangles and meshes")
+// defines: `v`, `vn` and `f` (polygons split into fans), indices in the forms v, v/vt, v//vn and
+// v/vt/vn, positive or negative (relative). Every other statement is ignored. A malformed
+// number or index is an error naming the file and line, never a silent zero.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "drt/util/math.h"
+
+namespace drt {
+
+// A file whose contents break the contract. what() is "OBJFILE:LINE: message".
+class ObjError : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+// A file that cannot be read at all. what() is the system's reason ("No such file or
+// directory"), so that the scene loader can name the element that asked for it.
+class ObjOpenError : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+struct ObjMesh {
+    static constexpr std::uint32_t kNoNormal = UINT32_MAX;
+
+    std::vector<Vec3> positions;  // the `v` statements, in order
+    std::vector<Vec3> normals;    // the `vn` statements, as written (not normalised)
+    // Three corners per triangle, in the file's order; a polygon of n corners gives the n - 2
+    // triangles (0, i, i + 1). Indices are 0-based.
+    std::vector<std::uint32_t> position_indices;
+    std::vector<std::uint32_t> normal_indices;  // parallel to position_indices; kNoNormal if none
+
+    std::size_t triangle_count() const { return position_indices.size() / 3; }
+};
+
+// `name` stands for the file in messages.
+ObjMesh parse_obj(std::string_view text, const std::string& name);
+// Throws ObjOpenError if the file cannot be read, ObjError if it is malformed.
+ObjMesh read_obj(const std::filesystem::path& path);
+
+}  // namespace drt

@@ -1,0 +1,142 @@
+// A render's estimate of its own error, from its own samples and no reference: how far each
+// pixel's mean is expected to lie from the converged value, and what that makes of the image's
+// RMSE and relative MSE (the measures drt converge takes against a reference, converge.h).
+//
+// Each pixel keeps a spread per channel, a guess at the variance of its mean. For independent
+// samples (the random sampler) it is their sample variance over n (pixel_spread), which is that
+// variance. For a stratified or Sobol pattern the sample variance ignores the stratification and
+// overstated the error by 1.3 to 10x (docs/accuracy.md); their spread is the strata spread
+// (strata_spread), from differences of neighbouring strata, which credits the stratification but
+// cannot see correlations between strata. There the spread only says where the error is, and the
+// image calibrates how large it is: a few pixels of each tile, chosen at random with odds that
+// grow with the spread around them (calibration_odds), are rendered a second time with an
+// independent pattern of the same sampler and count. Half the squared difference of the two
+// means has the variance of the mean as its expectation, whatever the pattern; summed over the
+// chosen pixels, each weighted by 1 / its odds, against the same weighted sum of their spreads,
+// it gives the factor (`scale`) that turns every pixel's spread into the variance of its mean.
+// The second renders only calibrate: the image is the first render's, unchanged.
+//
+// The spreads and the tile's sums are pure functions of the tile like its pixels, so they are
+// the same for any threads, tile order, process or resume; the image's estimate adds the tiles'
+// sums up in tile order.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "drt/io/image.h"
+#include "drt/util/color.h"
+#include "drt/util/math.h"
+
+namespace drt {
+
+// kIndependent: the spread is the variance of the mean. kCalibrated: a stratified or Sobol pattern,
+// calibrated by second renders.
+enum class SpreadKind { kIndependent, kCalibrated };
+
+// The share of an image's pixels rendered a second time, on average: the calibration's cost.
+inline constexpr double kCalibrationShare = 0.08;
+// A calibration of this many pixels pins the estimate's scale to a few per cent (the relative
+// spread of a variance from N independent differences is about sqrt(2 / N)); more would only
+// add cost, so a large image renders this many twice rather than kCalibrationShare of its
+// pixels (800 x 600: 0.9 % instead of 8 %).
+inline constexpr double kMaxCalibrationPixels = 4096;
+// Fewer pixels rendered twice than this leave the calibration too noisy to state a number.
+inline constexpr double kMinCalibrationPixels = 24;
+// A small image renders at least this many pixels twice (all of them below it). The
+// calibration's noise depends on how many pixels it takes, not on their share, and a small
+// image's error sits in few pixels: at 48 x 36 (aa-10spp, stratified 256 spp, 10 seeds) the
+// estimate ranged over 0.74-1.41 of the true RMSE with 8 % (~140 pixels), 0.91-1.14 with 512
+// (docs/accuracy.md). It costs 30 % more samples there and nothing above 6,400 pixels.
+inline constexpr double kMinSmallImageCalibration = 512;
+// The share for an image of `pixels` pixels: kCalibrationShare, capped at kMaxCalibrationPixels
+// pixels, or more for a small image, so that kMinSmallImageCalibration pixels are rendered twice
+// on average (all of them below that).
+double calibration_share(double pixels);
+
+// What the image's estimate adds up over the pixels rendered twice (kCalibrated).
+struct ErrorSums {
+    double variance = 0;  // half the squared difference of the two means, over channels, / odds
+    double spread = 0;    // the first render's spread, summed over channels, / odds
+    double pixels = 0;    // how many pixels were rendered twice
+    double samples = 0;   // the camera samples that took
+
+    ErrorSums& operator+=(const ErrorSums& o);
+    friend bool operator==(const ErrorSums&, const ErrorSums&) = default;
+};
+
+// The sample variance of one pixel's samples over their count, per channel; infinite for fewer
+// than two samples.
+Color pixel_spread(std::span<const Color> samples);
+
+// strata_spread's sort buffer, kept from pixel to pixel by its caller (one per thread) so that a
+// pixel's spread allocates nothing once the buffer has grown to the pixel's samples.
+struct StrataScratch {
+    // (band, place along it, sample index) of each sample, as strata_spread sorts them.
+    std::vector<std::tuple<std::size_t, double, std::uint32_t>> order;
+};
+
+// The spread of a stratified or Sobol pixel (the calibrated samplers): the variance of its mean
+// guessed from differences between neighbouring strata, per channel, from each sample's value and
+// position in the pixel (in [0, 1)^2). The pixel is cut into C = floor(sqrt(n)) columns and
+// R = ceil(n / C) rows, the cells of both samplers' patterns; along each row the samples in x
+// order and along each column in y order give, for three neighbours a, b, c, the term
+// (a - 2b + c)^2 / 6 (two neighbours, a band of two: (a - b)^2 / 2), whose expectation is one
+// stratum's variance where the pixel's value is linear across them plus noise. The mean term over
+// n is the variance of the mean if every stratum had that variance. A smooth gradient cancels,
+// unlike in the sample variance, which counts it whole and so overstated an edge's stratified
+// error about sqrt(n)-fold; an edge across a band counts about twice its variance, one along a
+// band once. The calibration then scales what is left (docs/accuracy.md). Infinite for fewer than
+// two samples.
+Color strata_spread(std::span<const Vec2> positions, std::span<const Color> samples,
+                    StrataScratch& scratch);
+
+// For each pixel of a tile (its spread image, row by row), the odds of rendering it a second
+// time: `share` on average over the tile, a quarter of them shared equally and the rest in
+// proportion to the largest spread of the pixel and its (up to 8) neighbours in the tile, at
+// most 1. Pixels where the samples spread more carry most of the error, so the calibration looks
+// there most often; the neighbours count because a pixel of few samples can miss the edge that
+// crosses it (no spread, yet a large error) while its neighbours along the edge show it. Every
+// pixel keeps some odds, so the weighted sums stay unbiased.
+std::vector<double> calibration_odds(const Image& spread, double share);
+
+// Adds a pixel rendered twice: `first` the image's mean and `spread` its spread, `second` the
+// mean of the independent render of `samples` camera samples, `odds` its calibration odds.
+void add_calibration(ErrorSums& sums, const Color& first, const Color& second, const Color& spread,
+                     double odds, std::uint32_t samples);
+
+struct ErrorEstimate {
+    // Both present, or neither: then `unavailable` says why.
+    std::optional<double> rmse;    // over all pixels and channels, as drt compare and converge
+    std::optional<double> relmse;  // mean of err^2 / (ref^2 + 0.01), the converged value unknown
+    std::string unavailable;
+    // A pixel's spread times `scale` is the estimated variance of its mean (when available).
+    double scale = 1;
+    // The camera samples the calibration took, over the image's: its cost.
+    double cost = 0;
+
+    bool available() const { return rmse.has_value(); }
+};
+
+// The expected RMSE and relative MSE of `image` against the converged image from the per-pixel
+// spreads (the same size), the image's sums and its camera `samples`. relMSE stands x^2 -
+// variance (at least 0) for the unknown ref^2. `spp` is the samples per pixel asked for: with 1
+// the pixel centre is taken and nothing can be estimated. Where no sample of any pixel spread and
+// no pixel rendered twice differed, the estimate is 0 however few were rendered twice. `pixels`
+// is how many pixels were rendered, the others left 0 (a pilot's, render_context.h): the mean is
+// theirs; 0 for all. Throws ImageError when the sizes differ.
+ErrorEstimate estimate_error(const Image& image, const Image& spread, const ErrorSums& sums,
+                             std::uint64_t samples, int spp, SpreadKind kind,
+                             std::uint64_t pixels = 0);
+
+// The per-pixel standard error, per channel: sqrt(spread x scale); 0 where there is no estimate.
+Image standard_error_image(const Image& spread, const ErrorEstimate& estimate);
+
+// "0.00123" or "n/a (reason)", as the finish line and drt converge print it.
+std::string format_estimate(const std::optional<double>& value, const std::string& unavailable);
+
+}  // namespace drt

@@ -1,0 +1,93 @@
+// The recursive tracer: the thesis's shading (Lambert direct light, mirror and Fresnel glass),
+// with every integral Cook distributes — pixel area, lens, time, light area, glossy
+// directions — sampled only where the render plan says the scene calls for it.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "drt/accel/bvh.h"
+#include "drt/accel/occluders.h"
+#include "drt/render/render_plan.h"
+#include "drt/sampling/sampler.h"
+#include "drt/scene/camera.h"
+#include "drt/scene/scene.h"
+
+namespace drt {
+
+// Rays actually traced, by kind.
+struct RayCounts {
+    std::uint64_t camera = 0, shadow = 0, reflection = 0, refraction = 0;
+
+    std::uint64_t total() const { return camera + shadow + reflection + refraction; }
+    RayCounts& operator+=(const RayCounts& o) {
+        camera += o.camera, shadow += o.shadow, reflection += o.reflection,
+            refraction += o.refraction;
+        return *this;
+    }
+};
+
+// Moves a ray origin off the surface it starts on, to the side `dir` leaves by, far enough that
+// rounding in the hit point cannot make the ray hit that surface again. The distance scales with
+// the point's magnitude (|p|·2⁻³² + 1e-9), a million times the double-precision rounding
+// error of a re-projected hit point, and still invisible (2.3e-5 at 1e5 from the origin).
+Ray spawn_ray(const Vec3& point, const Vec3& normal, const Vec3& dir, double time);
+
+// A direction about `ideal` whose angle from it is Rayleigh-distributed with scale sigma, i.e.
+// a 2-D normal distribution of standard deviation sigma (radians) on the tangent plane.
+Vec3 perturb_direction(const Vec3& ideal, double sigma, Vec2 u);
+
+// The ideal mirror and refracted directions of `d` (arriving against `geometric`) about the
+// shading normal, unless that would send the ray to the wrong side of the geometric surface —
+// as a bump or a mesh's interpolated normals can at grazing angles, where a reflected ray would
+// enter the object or a refracted one stay outside. Then the geometric normal decides, as for a
+// flat surface. refract_below is empty under total internal reflection.
+Vec3 reflect_above(const Vec3& d, const Vec3& shading, const Vec3& geometric);
+std::optional<Vec3> refract_below(const Vec3& d, const Vec3& shading, const Vec3& geometric,
+                                  double eta);
+
+class Integrator {
+  public:
+    Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bvh, const Sampler& sampler);
+
+    // Camera samples s.index, s.index + 1, ... of pixel (x, y): the radiance along each camera
+    // ray, into out. A run of a pixel's samples shares the work of drawing their camera points.
+    void sample_pixel(int x, int y, const PixelSample& s, std::span<Color> out,
+                      RayCounts& counts) const;
+
+    // Radiance arriving along `ray`, which is `depth` reflections/refractions from the camera.
+    Color radiance(const Ray& ray, const PixelSample& s, int depth, RayCounts& counts) const;
+
+  private:
+    // What the paths of one run of a pixel's samples share.
+    struct PixelWork {
+        RayCounts& counts;
+        RunPoints points;  // of the glossy dimensions
+    };
+
+    Color radiance(const Ray& ray, const PixelSample& s, int depth, PixelWork& work) const;
+    // Σ lights at a point: I · max(0, N·ω) · visibility, averaged over each light's shadow rays.
+    Color direct_light(const Vec3& point, const Vec3& geometric, const Vec3& shading, double time,
+                       const PixelSample& s, int depth, RayCounts& counts) const;
+    // One shadow ray from `origin` (spawned off the shading point) along a light sample.
+    Color light_ray(const Light& light, const LightSample& ls, const Vec3& origin,
+                    const Vec3& geometric, const Vec3& shading, double time,
+                    const Occluders& occluders, RayCounts& counts) const;
+    // Average radiance along `rays` directions about `ideal` (one exactly ideal ray if sigma is
+    // 0), each redrawn until it leaves on the `side` of the surface (+1 = the normal's side).
+    Color scattered(const Vec3& point, const Vec3& geometric, const Vec3& ideal, double sigma,
+                    double side, double time, const PixelSample& s, int depth, std::uint32_t kind,
+                    bool refraction, PixelWork& work) const;
+
+    const Scene& scene_;
+    const RenderPlan& plan_;
+    const Bvh& bvh_;
+    const Sampler& sampler_;
+    Camera camera_;
+    std::vector<const Light*> area_lights_;  // in scene order, as plan_.light_pick_cdf
+    bool any_visible_light_ = false;
+};
+
+}  // namespace drt

@@ -1,0 +1,20 @@
+// Whether a scene's render settings fit the limits of util/limits.h: checked before anything is
+// allocated, so that a render past them is bad input (exit 2) rather than a machine out of memory.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "drt/scene/scene.h"
+
+namespace drt {
+
+// The memory a render of these settings on `threads` worker threads needs at its peak.
+std::uint64_t estimated_render_bytes(const RenderSettings& settings, int threads);
+
+// Why these settings cannot be rendered on `threads` threads (0 = all cores), or nothing: a size
+// or count past its limit, or an estimate past kMemoryBudget. One line, naming the limit.
+std::optional<std::string> render_limit_problem(const RenderSettings& settings, int threads);
+
+}  // namespace drt

@@ -1,0 +1,108 @@
+#include <CLI/CLI.hpp>
+#include <iomanip>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <utility>
+
+#include "cli_common.h"
+#include "drt/goal/progressive.h"
+#include "drt/job/render_job.h"
+#include "drt/render/render_plan.h"
+#include "drt/scene/scene_loader.h"
+#include "drt/util/limits.h"
+#include "drt/util/text.h"
+
+namespace drt::cli {
+
+GoalForecast forecast(Scene& scene, double target, int threads) {
+    ProgressiveGoal goal;
+    goal.target_error = target;
+    goal.max_samples = kMaxSamples;
+    goal.pilots_only = true;
+    RenderJobOptions options;
+    options.threads = threads;
+    GoalForecast f;
+    const ProgressiveResult pilots = render_progressively(scene, options, goal);
+    f.pilots = pilots.rounds;
+    if (pilots.rounds.empty()) return f;
+    double seconds = 0;
+    for (const ProgressiveRound& r : pilots.rounds) seconds += r.seconds;
+    const NextRound last = next_round(pilots.rounds, target, kMaxSamples);
+    if (last.spp == 0) {
+        f.total = Prediction{pilots.samples, seconds};
+    } else if (last.final) {
+        f.final_round = last.spp;
+        f.total = Prediction{pilots.samples + last.spp,
+                             seconds + predicted_seconds(pilots.rounds, last.spp)};
+        if (const auto slow = predict(pilots.rounds, target, kMaxSamples, -0.5);
+            slow && slow->spp > last.spp) {
+            f.slow = Prediction{pilots.samples + slow->spp, seconds + slow->seconds};
+        }
+    }
+    return f;
+}
+
+std::string forecast_text(const GoalForecast& f, double target) {
+    std::ostringstream text;
+    text << "pilots:";
+    for (const ProgressiveRound& r : f.pilots) {
+        text << " " << r.spp << " spp";
+        if (!r.full()) text << " on 1 pixel in " << r.pixel_block * r.pixel_block << ",";
+        text << " " << std::fixed << std::setprecision(3) << r.seconds << " s, estimated rmse "
+             << std::defaultfloat << (r.error ? short_number(*r.error) : std::string("n/a")) << ";";
+    }
+    text << "\npredicted for --target-error " << short_number(target) << ": ";
+    if (f.total) {
+        // The goal render repeats the pilots, then adds the final round to them.
+        text << f.total->spp << " spp, " << std::fixed << std::setprecision(2) << f.total->seconds
+             << " s on this machine (rounds of " << std::defaultfloat;
+        const char* separator = "";
+        for (const ProgressiveRound& r : f.pilots) {
+            if (r.full()) text << std::exchange(separator, ", ") << r.spp;
+        }
+        if (f.final_round > 0) text << separator << f.final_round;
+        text << " spp)";
+        if (f.slow) {
+            text << "; if the error falls only as N^-1/2: " << f.slow->spp << " spp, " << std::fixed
+                 << std::setprecision(2) << f.slow->seconds << " s" << std::defaultfloat;
+        }
+    } else {
+        text << "n/a (the pilots give no error estimate to extrapolate)";
+    }
+    return text.str() + "\n";
+}
+
+int info_command(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+    CLI::App app{"Show what a scene contains and which effects it calls for", "drt info"};
+    std::string scene_path;
+    Overrides overrides;
+    std::optional<double> target;
+    int threads = 0;
+    app.add_option("scene", scene_path, "Scene file")->required();
+    overrides.add_to(app);
+    app.add_option("--target-error", target,
+                   "Also predict the samples per pixel and the time a render to this estimated "
+                   "RMSE takes here, from short pilot renders")
+        ->check(finite_positive());
+    app.add_option("--threads", threads, "Worker threads of the pilot renders (default: all cores)")
+        ->check(integer_in(1, kMaxThreads));
+    if (const auto status = parse_arguments(app, argc, argv, "drt info", out, err)) return *status;
+    try {
+        LoadedScene loaded = load_scene(scene_path);
+        for (const std::string& w : loaded.warnings) err << w << "\n";
+        overrides.apply(loaded.scene.settings);
+        out << describe(loaded.scene, plan_render(loaded.scene));
+        if (target) out << forecast_text(forecast(loaded.scene, *target, threads), *target);
+    } catch (const SceneError& e) {
+        err << e.what() << "\n";
+        return kBadInput;
+    } catch (const LimitError& e) {
+        err << "drt info: " << printable(scene_path) << ": " << e.what() << "\n";
+        return kBadInput;
+    }
+    return kOk;
+}
+
+}  // namespace drt::cli

@@ -1,0 +1,567 @@
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <new>
+#include <optional>
+#include <sstream>
+#include <stop_token>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli_common.h"
+#include "cli_render.h"
+#include "drt/goal/progressive.h"
+#include "drt/io/image.h"
+#include "drt/job/checkpoint.h"
+#include "drt/job/mpi_work.h"
+#include "drt/job/render_job.h"
+#include "drt/render/error_estimate.h"
+#include "drt/scene/render_limits.h"
+#include "drt/scene/scene_loader.h"
+#include "drt/util/atomic_file.h"
+#include "drt/util/interrupt.h"
+#include "drt/util/limits.h"
+#include "drt/util/text.h"
+
+namespace drt::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string format_duration(double seconds) {
+    const auto total = static_cast<long long>(std::llround(std::max(0.0, seconds)));
+    std::ostringstream s;
+    if (total >= 3600)
+        s << total / 3600 << ":" << std::setw(2) << std::setfill('0') << (total / 60) % 60;
+    else
+        s << total / 60;
+    s << ":" << std::setw(2) << std::setfill('0') << total % 60;
+    return s.str();
+}
+
+// A one-line progress display on a terminal: percent, elapsed and estimated remaining time.
+class ProgressDisplay {
+  public:
+    ProgressDisplay(std::ostream& err, std::string label) : err_(err), label_(std::move(label)) {}
+    void operator()(double done) {
+        const double elapsed =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+        const double left = done > 0 ? elapsed * (1 - done) / done : 0;
+        err_ << "\r" << label_ << " " << std::setw(3) << static_cast<int>(done * 100) << "%  "
+             << format_duration(elapsed) << " elapsed";
+        if (done > 0 && done < 1)
+            err_ << ", " << format_duration(left) << " left ";
+        else
+            err_ << "         ";
+        if (done >= 1) err_ << "\n";
+        err_ << std::flush;
+    }
+
+  private:
+    std::ostream& err_;
+    std::string label_;
+    std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+// --target-error and --time-limit: rounds of renders until the goal (progressive.h).
+struct GoalFlags {
+    std::optional<double> target_error, time_limit;
+
+    // `conflicting`: options that cannot go with a goal.
+    void add_to(CLI::App& app, const std::vector<CLI::Option*>& conflicting) {
+        CLI::Option* target =
+            app.add_option("--target-error", target_error,
+                           "Render until the image's estimated RMSE is at most E; --spp is then "
+                           "the maximum")
+                ->check(finite_positive());
+        CLI::Option* limit =
+            app.add_option("--time-limit", time_limit,
+                           "Render the best image that S seconds allow; --spp is then the maximum")
+                ->check(finite_positive());
+        for (CLI::Option* other : conflicting) {
+            target->excludes(other);
+            limit->excludes(other);
+        }
+    }
+    bool wanted() const { return target_error || time_limit; }
+};
+
+struct RenderJob {
+    Overrides overrides;
+    AdaptiveFlags adaptive;
+    GoalFlags goal;
+    int threads = 0;
+    bool quiet = false;
+    bool progress = false;
+    bool exr_half = false;
+    // Something shows the error estimate besides an .exr output's attributes (render_one adds
+    // those): the finish line, --stats, --error-image, a goal, a report.
+    bool estimate_shown = true;
+    std::string checkpoint;   // a file, or with several scenes a folder of <scene>.checkpoint
+    std::string error_image;  // one scene only: where its per-pixel standard error goes
+    double checkpoint_seconds = 30;
+    std::optional<std::size_t> stop_after_tiles;
+    bool grid_order = false;
+    std::stop_token stop;
+    const MpiJob* mpi = nullptr;
+
+    bool leader() const { return mpi == nullptr || mpi->leader(); }
+    // Under MPI: the highest status of all processes, so that all exit alike.
+    int agree(int status) const { return mpi ? mpi->highest(status) : status; }
+};
+
+// What an .exr header records about the render, so that the file says how it was made, and how
+// good it is: `estimatedError`, the estimated RMSE, when there is one.
+ImageWriteOptions output_options(const Scene& scene, const RenderResult& result,
+                                 const RenderJob& job) {
+    const RenderSettings& s = scene.settings;
+    ImageWriteOptions options;
+    options.half = job.exr_half;
+    options.attributes = {{"scene", scene.path},
+                          {"software", std::string("drt ") + DRT_VERSION},
+                          {"samplesPerPixel", s.samples},
+                          {"seed", std::to_string(s.seed)},  // 64 bits: no EXR number holds it
+                          {"sampler", s.sampler},
+                          {"renderSeconds", result.stats.seconds}};
+    if (const auto& a = result.stats.adaptive) {
+        options.attributes.push_back({"noiseThreshold", a->noise_threshold});
+        options.attributes.push_back({"minSamplesPerPixel", a->min_samples});
+    }
+    if (const auto& rmse = result.stats.error.rmse) {
+        options.attributes.push_back({"estimatedError", *rmse});
+        options.attributes.push_back({"estimatedRelMSE", *result.stats.error.relmse});
+    }
+    return options;
+}
+
+// Channel values that are NaN or infinite: radiance beyond the float range (a light of 1e39).
+std::size_t count_nonfinite(const Image& image) {
+    return static_cast<std::size_t>(std::count_if(image.rgb.begin(), image.rgb.end(),
+                                                  [](float v) { return !std::isfinite(v); }));
+}
+
+// Turns a signal (interrupt.h) into a stop request for the render in progress. The handler may
+// only set a flag, so it is polled here; a second signal still ends drt at once.
+class SignalStop {
+  public:
+    SignalStop()
+        : poller_([this](std::stop_token done) {
+              while (!done.stop_requested()) {
+                  if (stop_signal().load() != 0) {
+                      source_.request_stop();
+                      return;
+                  }
+                  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+              }
+          }) {}
+    std::stop_token token() const { return source_.get_token(); }
+
+  private:
+    CooperativeStop cooperative_;
+    std::stop_source source_;
+    std::jthread poller_;  // last: stopped and joined before the rest goes
+};
+
+// What a render to a goal reached, and how to render the same image again.
+std::string goal_summary(const std::string& name, const ProgressiveResult& p, const GoalFlags& goal,
+                         double seconds) {
+    std::ostringstream line;
+    line << "drt: " << name << ": " << p.samples << " spp after ";
+    const char* separator = "rounds of ";
+    // In the order they ran: "rounds of 8, 18 spp", then any top-up, and a full round after a
+    // top-up (a time limit's cut) as "a round of N spp".
+    bool listing = false;  // inside the list of full rounds, " spp" still to come
+    bool topped = false;
+    for (const ProgressiveRound& r : p.rounds) {
+        if (!r.full() && !r.top_up()) {
+            line << "a pilot of " << r.spp << " spp on 1 pixel in " << r.pixel_block * r.pixel_block
+                 << ", ";
+        } else if (r.top_up()) {
+            line << (listing ? " spp" : "") << ", a top-up of 2 x " << r.spp << " spp on "
+                 << std::fixed << std::setprecision(2) << 100 * r.top_up_share << std::defaultfloat
+                 << " % of the pixels";
+            listing = false;
+            topped = true;
+        } else if (topped) {
+            line << ", a round of " << r.spp << " spp";
+        } else {
+            line << separator << r.spp;
+            separator = ", ";
+            listing = true;
+        }
+    }
+    line << (listing ? " spp" : "") << "; estimated rmse "
+         << (p.error ? short_number(*p.error) : std::string("n/a"));
+    if (goal.target_error) {
+        line << " (target " << short_number(*goal.target_error)
+             << (p.target_met ? " met)" : " not met)");
+    }
+    if (goal.time_limit) {
+        line << "; " << std::fixed << std::setprecision(2) << seconds << " s of the "
+             << short_number(*goal.time_limit) << " s limit" << std::defaultfloat;
+    }
+    const auto full =
+        std::count_if(p.rounds.begin(), p.rounds.end(),
+                      [](const ProgressiveRound& r) { return r.full() || r.top_up(); });
+    if (!p.combined || full == 1) {
+        // A target error's one full round is the plain render of its count (progressive.h).
+        line << "\ndrt: " << name << ": --spp " << p.samples
+             << " renders the same image (bit-identical) without a goal\n";
+    } else {
+        line << "\ndrt: " << name
+             << ": the rounds' images combined (weighted by 1 / estimated variance); the same "
+                "command renders the same image "
+             << (goal.time_limit ? "where it completes the same rounds\n"
+                                 : "(bit-identical) every run\n");
+    }
+    return line.str();
+}
+
+// `<stem>.partial.<ext>` beside the output: an interrupted render's finished tiles.
+fs::path partial_path(const fs::path& output) {
+    return output.parent_path() /
+           (output.stem().string() + ".partial" + output.extension().string());
+}
+
+// Runs `step`, turning every exception into a message and a status.
+template <typename Step>
+int guarded(const std::string& name, std::ostream& err, Step&& step) {
+    try {
+        step();
+        return kOk;
+    } catch (const SceneError& e) {
+        err << e.what() << "\n";
+    } catch (const ImageError& e) {
+        err << "drt: " << e.what() << "\n";
+    } catch (const CheckpointError& e) {
+        err << "drt: " << printable(e.what()) << "\n";
+    } catch (const LimitError& e) {
+        err << "drt: " << name << ": " << e.what() << "\n";
+    } catch (const std::bad_alloc&) {
+        err << "drt: " << name << ": out of memory\n";
+        return kFailed;
+    } catch (const std::exception& e) {
+        err << "drt: " << name << ": " << printable(e.what()) << "\n";
+        return kFailed;
+    }
+    return kBadInput;
+}
+
+// One scene, start to end. Everything that can go wrong ends here as a message and a status, so
+// that a batch goes on with its other scenes: this is the job boundary. Under MPI every process
+// runs it, and all agree on the status after each step, so that none waits for another that
+// gave up.
+SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
+                        const std::optional<fs::path>& checkpoint, const RenderJob& job,
+                        std::ostream& err) {
+    const auto start = std::chrono::steady_clock::now();  // a time limit counts from here
+    SceneOutcome outcome;
+    outcome.scene = scene_path;
+    const std::string name = printable(scene_path);
+    std::optional<LoadedScene> loaded;
+    int status = guarded(name, err, [&] {
+        format_for_path(output);  // refuse an unknown extension before spending time rendering
+        loaded.emplace(load_scene(scene_path));
+        for (const std::string& w : loaded->warnings) err << w << "\n";
+        job.overrides.apply(loaded->scene.settings);
+        RenderSettings largest = loaded->scene.settings;
+        if (job.goal.wanted() && !job.overrides.spp) largest.samples = kMaxSamples;
+        if (const auto problem = render_limit_problem(largest, job.threads)) {
+            throw LimitError(*problem);
+        }
+    });
+    if (const int agreed = job.agree(status); agreed != kOk) {
+        if (status == kOk) err << "drt: " << name << ": failed in another process\n";
+        outcome.status = agreed;
+        return outcome;
+    }
+    const Scene& scene = loaded->scene;
+    RenderJobOptions options;
+    options.threads = job.threads;
+    options.adaptive = job.adaptive.settings();
+    options.checkpoint = checkpoint;
+    options.scene_files = {scene_path};
+    options.scene_files.insert(options.scene_files.end(), loaded->files_read.begin(),
+                               loaded->files_read.end());
+    options.checkpoint_interval = std::chrono::duration<double>(job.checkpoint_seconds);
+    options.stop_after_tiles = job.stop_after_tiles;
+    options.costly_first = !job.grid_order;
+    options.estimate_error = job.estimate_shown || format_for_path(output) == ImageFormat::kExr;
+    options.stop = job.stop;
+    options.mpi = job.mpi;
+    std::optional<ProgressDisplay> display;
+    if (job.progress && job.leader()) {
+        display.emplace(err, printable(fs::path(scene_path).filename().string()));
+        options.on_progress = [&](double done) { (*display)(done); };
+    }
+    RenderJobResult r;
+    std::optional<ProgressiveResult> rounds;
+    status = guarded(name, err, [&] {
+        if (!job.goal.wanted()) {
+            r = run_render_job(scene, options);
+            return;
+        }
+        ProgressiveGoal goal;
+        goal.target_error = job.goal.target_error;
+        goal.time_limit = job.goal.time_limit;
+        goal.max_samples = job.overrides.spp.value_or(kMaxSamples);
+        goal.start = start;
+        rounds = render_progressively(loaded->scene, options, goal);
+        r = std::move(rounds->job);
+        loaded->scene.settings.samples = rounds->samples;
+        r.render.stats.seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    });
+    if (status != kOk || !job.leader()) {
+        outcome.status = job.agree(status);
+        return outcome;
+    }
+    const RenderResult& result = r.render;
+    outcome.width = scene.settings.width;
+    outcome.height = scene.settings.height;
+    outcome.samples = scene.settings.samples;
+    outcome.seconds = result.stats.seconds;
+    outcome.mrays_per_second =
+        result.stats.seconds > 0 ? result.stats.rays.total() / result.stats.seconds / 1e6 : 0;
+    const fs::path target = r.complete() ? output : partial_path(output);
+    try {
+        write_image(result.image, target, output_options(scene, result, job));
+    } catch (const ImageError& e) {
+        err << "drt: " << e.what() << "\n";
+        outcome.status = job.agree(kFailed);
+        return outcome;
+    }
+    if (!r.complete()) {
+        const int sig = stop_signal().load();
+        err << "drt: " << name << ": interrupted with " << r.done << " of " << r.tiles
+            << " tiles done; wrote " << printable(target.string());
+        if (checkpoint) {
+            err << " and " << printable(checkpoint->string())
+                << "\ndrt: run the same command again to resume\n";
+        } else if (job.goal.wanted()) {
+            // A goal's rounds keep no checkpoint (--checkpoint excludes them): no hint to one.
+            err << " (the goal's first round; a goal render cannot be resumed)\n";
+        } else {
+            err << "\ndrt: with --checkpoint FILE an interrupted render can be resumed\n";
+        }
+        outcome.status = job.agree(sig != 0 ? 128 + sig : kInterrupted);
+        return outcome;
+    }
+    outcome.json = stats_json(
+        scene, result,
+        rounds ? goal_json(*rounds, job.goal.target_error, job.goal.time_limit, scene.settings.seed)
+               : std::string());
+    if (!job.error_image.empty()) {
+        try {
+            write_image(standard_error_image(result.spread, result.stats.error), job.error_image,
+                        output_options(scene, result, job));
+        } catch (const ImageError& e) {
+            err << "drt: " << e.what() << "\n";
+            outcome.status = job.agree(kFailed);
+            return outcome;
+        }
+    }
+    if (checkpoint) {
+        std::error_code ignored;
+        fs::remove(*checkpoint, ignored);
+        // What an earlier, interrupted run left is superseded by the image.
+        if (r.resumed > 0) fs::remove(partial_path(output), ignored);
+    }
+    if (!job.quiet) {
+        err << "drt: wrote " << printable(output.string()) << " (" << outcome.width << "x"
+            << outcome.height << ", " << outcome.samples << " spp, " << std::fixed
+            << std::setprecision(2) << outcome.seconds << " s";
+        if (r.resumed > 0) err << ", " << r.resumed << " of " << r.tiles << " tiles resumed";
+        err << ", estimated RMSE "
+            << format_estimate(result.stats.error.rmse, result.stats.error.unavailable) << ")\n"
+            << std::defaultfloat;
+        if (rounds) err << goal_summary(name, *rounds, job.goal, outcome.seconds);
+    }
+    if (rounds && rounds->stopped) {
+        // Interrupted between or during rounds: the image is the complete rounds'.
+        const int sig = stop_signal().load();
+        err << "drt: " << name << ": interrupted; kept "
+            << (rounds->combined ? "the complete rounds combined\n" : "the last complete round\n");
+        outcome.status = job.agree(sig != 0 ? 128 + sig : kInterrupted);
+        return outcome;
+    }
+    // Written all the same, for inspection, but not a success: no pixel may be silently lost.
+    if (const std::size_t bad = count_nonfinite(result.image)) {
+        err << "drt: " << name << ": " << bad << " of " << result.image.rgb.size()
+            << " channel values are not finite (radiance beyond the float range: a light, "
+               "background or ambient too bright?)\n";
+        status = kBadInput;
+    }
+    outcome.status = job.agree(status);
+    return outcome;
+}
+
+}  // namespace
+
+int render_command(int argc, const char* const* argv, std::ostream& out, std::ostream& err,
+                   const MpiJob* mpi) {
+    CLI::App app{
+        "drt: distributed ray tracer (Cook, Porter & Carpenter 1984).\n"
+        "Also: drt compare A B [--max-rmse X] [--diff D.png] | drt info SCENE.xml | "
+        "drt converge SCENE.xml --spp 1,4,16",
+        "drt"};
+    std::vector<std::string> scenes;
+    std::string output, stats;
+    RenderJob job;
+    bool force_progress = false;
+    app.add_option("scenes", scenes, "Scene file(s) in the thesis XML format")->required();
+    app.add_option("-o,--output", output,
+                   "Output image (.png, .bmp, .pfm, .exr); with several scenes, a folder");
+    app.add_flag("--exr-half", job.exr_half,
+                 "Write .exr channels as 16-bit half floats instead of 32-bit floats");
+    job.overrides.add_to(app);
+    CLI::Option* threshold = job.adaptive.add_to(app);
+    app.add_option("--threads", job.threads, "Worker threads (default: all cores)")
+        ->check(integer_in(1, kMaxThreads));
+    app.add_option("--stats", stats, "Write render statistics as JSON to FILE (- = stdout)");
+    app.add_option("--error-image", job.error_image,
+                   "Write each pixel's estimated standard error (per channel, linear) to FILE "
+                   "(.png, .bmp, .pfm, .exr)");
+    app.add_flag("-q,--quiet", job.quiet, "No progress display or messages besides errors");
+    app.add_flag("--progress", force_progress, "Show progress even when stderr is not a terminal");
+    CLI::Option* checkpoint =
+        app.add_option("--checkpoint", job.checkpoint,
+                       "Keep finished work in FILE (with several scenes, a folder); running the "
+                       "same command again resumes from it; removed when the render completes");
+    job.goal.add_to(app, {threshold, checkpoint});
+    app.add_option("--checkpoint-every", job.checkpoint_seconds,
+                   "Seconds between checkpoint writes (default 30)")
+        ->check(CLI::NonNegativeNumber);
+    // For tests: stop as SIGINT would once N tiles are done.
+    app.add_option("--stop-after-tiles", job.stop_after_tiles)->group("");
+    // For bench/mpi.sh: hand tiles out row by row, to measure what costly-first saves.
+    app.add_flag("--grid-order", job.grid_order)->group("");
+    BatchReport report;
+    report.add_to(app);
+    app.set_version_flag("--version", std::string("drt ") + DRT_VERSION);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp&) {
+        out << app.help();
+        return kOk;
+    } catch (const CLI::CallForVersion&) {
+        out << "drt " << DRT_VERSION << "\n";
+        return kOk;
+    } catch (const CLI::ParseError& e) {
+        err << "drt: " << printable(e.what()) << "\nRun 'drt --help' for usage.\n";
+        return kBadInput;
+    }
+    // Before any image replaces its output, so that a run never ends half done for want of it.
+    job.mpi = mpi;
+    if (!stats.empty() && stats != "-" && job.leader()) {
+        try {
+            check_replaceable(stats);
+        } catch (const FileWriteError& e) {
+            err << "drt: --stats " << e.what() << "\n";
+            return job.agree(kBadInput);
+        }
+    }
+    if (!job.error_image.empty() && job.leader()) {
+        try {
+            format_for_path(job.error_image);
+            check_replaceable(job.error_image);
+        } catch (const ImageError& e) {
+            err << "drt: --error-image " << e.what() << "\n";
+            return job.agree(kBadInput);
+        } catch (const FileWriteError& e) {
+            err << "drt: --error-image " << e.what() << "\n";
+            return job.agree(kBadInput);
+        }
+    }
+    if (job.agree(kOk) != kOk) return kBadInput;
+    job.progress = !job.quiet && (force_progress || isatty(STDERR_FILENO));
+    job.estimate_shown = !job.quiet || !stats.empty() || !job.error_image.empty() ||
+                         job.goal.wanted() || report.wanted;
+
+    const bool batch = scenes.size() > 1 || is_folder_target(output);
+    if (batch && !job.error_image.empty()) {
+        err << "drt: --error-image takes one scene, not a batch\nRun 'drt --help' for usage.\n";
+        return kBadInput;
+    }
+    if (report.wanted && !(batch && !output.empty())) {
+        err << "drt: --report needs a batch: -o DIR/\nRun 'drt --help' for usage.\n";
+        return kBadInput;
+    }
+    int made = kOk;
+    if (job.leader()) {
+        for (const std::string& folder : {batch ? output : "", batch ? job.checkpoint : ""}) {
+            if (folder.empty()) continue;
+            std::error_code ec;
+            fs::create_directories(folder, ec);
+            if (ec) {
+                err << "drt: " << printable(folder) << ": cannot create folder: " << ec.message()
+                    << "\n";
+                made = kFailed;
+            }
+        }
+    }
+    if (job.agree(made) != kOk) return kFailed;
+    const SignalStop signals;
+    job.stop = signals.token();
+    std::vector<SceneOutcome> outcomes;
+    for (const std::string& scene : scenes) {
+        fs::path target = fs::path(scene).stem().string() + ".png";
+        std::optional<fs::path> checkpoint;
+        if (!job.checkpoint.empty()) checkpoint = job.checkpoint;
+        if (batch) {
+            if (!output.empty()) target = fs::path(output) / target;
+            if (checkpoint) *checkpoint /= fs::path(scene).stem().string() + ".checkpoint";
+        } else if (!output.empty()) {
+            target = output;
+        }
+        outcomes.push_back(render_one(scene, target, checkpoint, job, err));
+        outcomes.back().output = target;
+        // An interrupt ends the batch: the scenes after it are not started.
+        if (outcomes.back().status > kBadInput) break;
+    }
+
+    int status = kOk;
+    for (const SceneOutcome& o : outcomes) status = std::max(status, o.status);
+    if (!job.leader()) return status;  // the leader reports for all
+    if (!stats.empty()) {
+        std::string json;
+        if (!batch) {
+            json = outcomes.front().json;
+        } else {
+            json = "{\"scenes\": [";
+            bool first = true;
+            for (const SceneOutcome& o : outcomes) {
+                if (o.json.empty()) continue;
+                json += (first ? "\n" : ",\n") + o.json;
+                first = false;
+            }
+            json += "]}";
+        }
+        if (!json.empty()) {
+            if (stats == "-") {
+                out << json << "\n";
+            } else {
+                try {
+                    write_text_atomically(stats, json);
+                } catch (const std::exception& e) {
+                    err << "drt: " << e.what() << "\n";
+                    status = std::max(status, kFailed);
+                }
+            }
+        }
+    }
+    if (batch) print_summary(outcomes, stats == "-" ? err : out);
+    if (report.wanted)
+        status = std::max(status, report.write(outcomes, fs::path(output), job.quiet, err));
+    return status;
+}
+
+}  // namespace drt::cli

@@ -1,0 +1,371 @@
+#include "drt/job/checkpoint.h"
+
+#include <bit>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <system_error>
+
+#include "drt/util/atomic_file.h"
+#include "drt/util/rng.h"
+#include "drt/util/text.h"
+
+namespace drt {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Bytes = std::vector<unsigned char>;
+
+// "DRTCKPT" and a format number: a reader refuses a format it does not know instead of guessing.
+// Format 2 added each pixel's spread and each tile's error sums (error_estimate.h); format 3
+// fingerprints each file the scene reads on its own (format 2 had one hash for them all); format 4
+// holds the error sums of the estimate's calibration instead of sobol's run spreads.
+constexpr char kMagic[8] = {'D', 'R', 'T', 'C', 'K', 'P', 'T', '4'};
+// The longest version string a reader accepts, so a damaged length cannot ask for gigabytes.
+constexpr std::uint32_t kMaxVersionLength = 256;
+// Likewise for a file's name (PATH_MAX on Linux).
+constexpr std::uint32_t kMaxNameLength = 4096;
+
+[[noreturn]] void fail(const fs::path& file, const std::string& what) {
+    throw CheckpointError(file.string() + ": " + what);
+}
+
+class Writer {
+  public:
+    void u32(std::uint32_t v) { put(v, 4); }
+    void u64(std::uint64_t v) { put(v, 8); }
+    void f32(float v) { u32(std::bit_cast<std::uint32_t>(v)); }
+    void f64(double v) { u64(std::bit_cast<std::uint64_t>(v)); }
+    void text(const std::string& s) {
+        u32(static_cast<std::uint32_t>(s.size()));
+        bytes.insert(bytes.end(), s.begin(), s.end());
+    }
+    void tile(const TileBuffer& t) {
+        u64(t.tile.index);
+        for (float v : t.pixels.rgb) f32(v);
+        for (std::uint32_t n : t.pixel_samples) u32(n);
+        for (float v : t.spread.rgb) f32(v);
+        f64(t.error_sums.variance);
+        f64(t.error_sums.spread);
+        f64(t.error_sums.pixels);
+        f64(t.error_sums.samples);
+        u64(t.rays.camera);
+        u64(t.rays.shadow);
+        u64(t.rays.reflection);
+        u64(t.rays.refraction);
+        u64(t.samples);
+        u64(t.converged);
+    }
+    Bytes bytes;
+
+  private:
+    // Little-endian whatever the host, so a checkpoint moves between machines.
+    void put(std::uint64_t v, int size) {
+        for (int i = 0; i < size; ++i) bytes.push_back(static_cast<unsigned char>(v >> (8 * i)));
+    }
+};
+
+class Reader {
+  public:
+    Reader(std::span<const unsigned char> bytes, const fs::path& file)
+        : bytes_(bytes), file_(file) {}
+    std::uint32_t u32() { return static_cast<std::uint32_t>(get(4)); }
+    std::uint64_t u64() { return get(8); }
+    float f32() { return std::bit_cast<float>(u32()); }
+    double f64() { return std::bit_cast<double>(u64()); }
+    std::string text(std::uint32_t max) {
+        const std::uint32_t n = u32();
+        if (n > max) fail(file_, "damaged checkpoint (bad text length)");
+        need(n);
+        std::string s(reinterpret_cast<const char*>(bytes_.data() + pos_), n);
+        pos_ += n;
+        return s;
+    }
+    // A tile of `grid`, not one of those marked in `seen`, which it then marks.
+    TileBuffer tile(std::span<const Tile> grid, std::vector<bool>& seen) {
+        const std::uint64_t index = u64();
+        if (index >= grid.size() || seen[index]) fail(file_, "damaged checkpoint (bad tile index)");
+        seen[index] = true;
+        TileBuffer t;
+        t.tile = grid[index];
+        t.pixels = Image(t.tile.width(), t.tile.height());
+        need(t.pixels.rgb.size() * 4);
+        for (float& v : t.pixels.rgb) v = f32();
+        t.pixel_samples.resize(static_cast<std::size_t>(t.tile.width()) * t.tile.height());
+        for (std::uint32_t& n : t.pixel_samples) n = u32();
+        t.spread = Image(t.tile.width(), t.tile.height());
+        need(t.spread.rgb.size() * 4);
+        for (float& v : t.spread.rgb) v = f32();
+        t.error_sums.variance = f64();
+        t.error_sums.spread = f64();
+        t.error_sums.pixels = f64();
+        t.error_sums.samples = f64();
+        t.rays.camera = u64();
+        t.rays.shadow = u64();
+        t.rays.reflection = u64();
+        t.rays.refraction = u64();
+        t.samples = u64();
+        t.converged = u64();
+        return t;
+    }
+    std::size_t left() const { return bytes_.size() - pos_; }
+
+  private:
+    void need(std::size_t n) const {
+        if (left() < n) fail(file_, "truncated checkpoint");
+    }
+    std::uint64_t get(int size) {
+        need(static_cast<std::size_t>(size));
+        std::uint64_t v = 0;
+        for (int i = 0; i < size; ++i) v |= std::uint64_t{bytes_[pos_ + i]} << (8 * i);
+        pos_ += static_cast<std::size_t>(size);
+        return v;
+    }
+    std::span<const unsigned char> bytes_;
+    const fs::path& file_;
+    std::size_t pos_ = 0;
+};
+
+// A format byte as printed: the digit, or its code when it is not one.
+std::string printable_format(unsigned char c) {
+    if (c >= '0' && c <= '9') return std::string(1, static_cast<char>(c));
+    return "byte " + std::to_string(c);
+}
+
+Bytes read_all(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) fail(file, "cannot open file: " + std::generic_category().message(errno));
+    Bytes data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) fail(file, "cannot read file");
+    return data;
+}
+
+// What differs between the files a checkpoint's render read (`got`) and this render's.
+std::string files_differing(const std::vector<FileFingerprint>& got,
+                            const std::vector<FileFingerprint>& expected) {
+    if (got.empty() || expected.empty() || !(got[0] == expected[0])) {
+        return "another scene file (its contents differ)";
+    }
+    if (got.size() != expected.size()) {
+        return "a scene reading another number of files (" + std::to_string(got.size() - 1) +
+               ", not " + std::to_string(expected.size() - 1) + ")";
+    }
+    for (std::size_t i = 1; i < got.size(); ++i) {
+        if (!(got[i] == expected[i])) {
+            return "another version of " + printable(expected[i].name) +
+                   " (a file the scene reads: its contents differ)";
+        }
+    }
+    return "other files";
+}
+
+// Doubles by their bits, so that two settings that print alike but differ still differ.
+std::string exact(double v) {
+    return std::to_string(std::bit_cast<std::uint64_t>(v));
+}
+
+}  // namespace
+
+std::uint64_t hash_bytes(std::span<const unsigned char> bytes) {
+    std::uint64_t h = hash_of(bytes.size());
+    std::size_t i = 0;
+    for (; i + 8 <= bytes.size(); i += 8) {
+        std::uint64_t word = 0;
+        for (int b = 0; b < 8; ++b) word |= std::uint64_t{bytes[i + b]} << (8 * b);
+        h = hash_combine(h, word);
+    }
+    std::uint64_t tail = 0;
+    for (int b = 0; i < bytes.size(); ++i, ++b) tail |= std::uint64_t{bytes[i]} << (8 * b);
+    return hash_combine(h, tail);
+}
+
+RenderIdentity identify_render(std::span<const fs::path> files, const RenderSettings& settings,
+                               const std::optional<AdaptiveSampling>& adaptive,
+                               std::uint64_t tiles) {
+    RenderIdentity id;
+    id.version = DRT_VERSION;
+    for (const fs::path& f : files) {
+        try {
+            id.files.push_back({f.string(), hash_bytes(read_all(f))});
+        } catch (const CheckpointError& e) {
+            throw CheckpointError(std::string(e.what()) + " (needed for the checkpoint)");
+        }
+    }
+    std::ostringstream options;
+    options << "width " << settings.width << " height " << settings.height << " samples "
+            << settings.samples << " shadow_rays " << settings.shadow_rays << " max_depth "
+            << settings.max_depth << " glossy_rays " << settings.glossy_rays << " seed "
+            << settings.seed << " sampler " << settings.sampler << " pixel_plane_unit "
+            << exact(settings.pixel_plane_unit);
+    if (adaptive) {
+        options << " noise_threshold " << exact(adaptive->noise_threshold) << " min_spp "
+                << adaptive->min_samples;
+    }
+    const std::string text = options.str();
+    id.options = hash_bytes({reinterpret_cast<const unsigned char*>(text.data()), text.size()});
+    id.width = settings.width;
+    id.height = settings.height;
+    id.tiles = tiles;
+    return id;
+}
+
+std::vector<unsigned char> encode_checkpoint(const RenderIdentity& id,
+                                             std::span<const TileBuffer> tiles) {
+    Writer w;
+    w.bytes.insert(w.bytes.end(), std::begin(kMagic), std::end(kMagic));
+    w.text(id.version);
+    w.u64(id.files.size());
+    for (const FileFingerprint& f : id.files) {
+        w.text(f.name);
+        w.u64(f.hash);
+    }
+    w.u64(id.options);
+    w.u32(static_cast<std::uint32_t>(id.width));
+    w.u32(static_cast<std::uint32_t>(id.height));
+    w.u64(id.tiles);
+    w.u64(tiles.size());
+    for (const TileBuffer& t : tiles) w.tile(t);
+    w.u64(hash_bytes(w.bytes));
+    return std::move(w.bytes);
+}
+
+Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<const Tile> grid,
+                             const fs::path& file) {
+    if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic - 1) != 0) {
+        fail(file, "not a drt checkpoint");
+    }
+    if (bytes[sizeof kMagic - 1] != static_cast<unsigned char>(kMagic[sizeof kMagic - 1])) {
+        fail(file, std::string("checkpoint format ") + printable_format(bytes[sizeof kMagic - 1]) +
+                       " of another drt version, this one reads format " +
+                       kMagic[sizeof kMagic - 1] +
+                       ": not resumed and nothing written (delete it or name another "
+                       "--checkpoint file)");
+    }
+    if (bytes.size() < sizeof kMagic + 8) fail(file, "truncated checkpoint");
+    const auto body = bytes.first(bytes.size() - 8);
+    Reader tail(bytes.last(8), file);
+    if (tail.u64() != hash_bytes(body)) {
+        fail(file, "damaged or truncated checkpoint (checksum does not match)");
+    }
+    Reader r(body.subspan(sizeof kMagic), file);
+    Checkpoint c;
+    RenderIdentity& id = c.identity;
+    id.version = r.text(kMaxVersionLength);
+    const std::uint64_t files = r.u64();
+    // Each takes at least 12 bytes, so a damaged count soon runs out of file.
+    for (std::uint64_t i = 0; i < files; ++i) {
+        FileFingerprint& f = id.files.emplace_back();
+        f.name = r.text(kMaxNameLength);
+        f.hash = r.u64();
+    }
+    id.options = r.u64();
+    id.width = static_cast<int>(r.u32());
+    id.height = static_cast<int>(r.u32());
+    id.tiles = r.u64();
+    if (id.tiles != grid.size()) fail(file, "checkpoint of another image size");
+    const std::uint64_t count = r.u64();
+    if (count > grid.size()) fail(file, "damaged checkpoint (more tiles than the image has)");
+    std::vector<bool> seen(grid.size(), false);
+    for (std::uint64_t i = 0; i < count; ++i) c.tiles.push_back(r.tile(grid, seen));
+    if (r.left() != 0) fail(file, "damaged checkpoint (bytes after the last tile)");
+    return c;
+}
+
+std::optional<Checkpoint> read_checkpoint(const fs::path& file, const RenderIdentity& expected,
+                                          std::span<const Tile> grid) {
+    std::error_code ec;
+    const fs::file_status status = fs::status(file, ec);
+    if (status.type() == fs::file_type::not_found) return std::nullopt;
+    if (ec) fail(file, "cannot examine file: " + ec.message());
+    if (status.type() != fs::file_type::regular) fail(file, "not a regular file");
+    Checkpoint c = decode_checkpoint(read_all(file), grid, file);
+    const RenderIdentity& got = c.identity;
+    std::string differs;
+    if (got.version != expected.version) {
+        differs = "drt " + got.version + ", not drt " + expected.version;
+    } else if (got.files != expected.files) {
+        differs = files_differing(got.files, expected.files);
+    } else if (got.width != expected.width || got.height != expected.height) {
+        differs = "another image size (" + std::to_string(got.width) + "x" +
+                  std::to_string(got.height) + ")";
+    } else if (got.options != expected.options || got.tiles != expected.tiles) {
+        differs = "other options (samples, seed, sampler or another setting differs)";
+    }
+    if (!differs.empty()) {
+        fail(file, "checkpoint of another render: made by " + differs +
+                       "; not resumed and nothing written (delete it or name another "
+                       "--checkpoint file)");
+    }
+    return c;
+}
+
+std::vector<unsigned char> encode_tile(const TileBuffer& tile) {
+    Writer w;
+    w.tile(tile);
+    return std::move(w.bytes);
+}
+
+TileBuffer decode_tile(std::span<const unsigned char> bytes, std::span<const Tile> grid,
+                       const fs::path& source) {
+    Reader r(bytes, source);
+    std::vector<bool> seen(grid.size(), false);
+    TileBuffer t = r.tile(grid, seen);
+    if (r.left() != 0) fail(source, "damaged tile (bytes after its end)");
+    return t;
+}
+
+CheckpointSink::CheckpointSink(TileSink& next, fs::path file, RenderIdentity identity,
+                               std::chrono::duration<double> interval,
+                               std::vector<TileBuffer> resumed)
+    : next_(next),
+      file_(std::move(file)),
+      identity_(std::move(identity)),
+      interval_(interval),
+      tiles_(std::move(resumed)) {
+    for (const TileBuffer& t : tiles_) next_.add(t);
+}
+
+void CheckpointSink::add(TileBuffer buffer) {
+    next_.add(buffer);
+    bool due = false;
+    {
+        const std::lock_guard lock(mutex_);
+        tiles_.push_back(std::move(buffer));
+        const auto now = std::chrono::steady_clock::now();
+        if (now - last_write_ >= interval_) {
+            last_write_ = now;
+            due = true;
+        }
+    }
+    if (!due) return;
+    // A write that fails on the way (a signal removes the temporary file it was writing) is
+    // tried again at the next interval and when the render stops, where a failure is reported.
+    try {
+        write();
+    } catch (const CheckpointError&) {
+    }
+}
+
+std::size_t CheckpointSink::tiles_done() const {
+    const std::lock_guard lock(mutex_);
+    return tiles_.size();
+}
+
+void CheckpointSink::write() {
+    const std::lock_guard lock(writing_);
+    std::vector<unsigned char> bytes;
+    {
+        const std::lock_guard tiles_lock(mutex_);
+        bytes = encode_checkpoint(identity_, tiles_);
+    }
+    try {
+        replace_file(file_, bytes);
+    } catch (const FileWriteError& e) {
+        throw CheckpointError(e.what());
+    }
+}
+
+}  // namespace drt

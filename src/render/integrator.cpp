@@ -1,0 +1,271 @@
+#include "drt/render/integrator.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <span>
+#include <vector>
+
+#include "drt/util/rng.h"
+
+namespace drt {
+
+namespace {
+
+// Attempts at drawing a perturbed direction on the right side of a surface before falling back
+// to the ideal one; at grazing incidence about half the draws land on the wrong side, so the
+// fallback is taken with probability about 2^-32.
+constexpr int kRedrawAttempts = 32;
+
+// The point of the unit square that Light::sample maps to the light's centre as seen from outside
+// (cos θ = 1 in the cone): a light whose area is not sampled acts as a point there.
+constexpr Vec2 kLightCentre{0, 0};
+
+}  // namespace
+
+Vec3 reflect_above(const Vec3& d, const Vec3& shading, const Vec3& geometric) {
+    const Vec3 r = reflect(d, shading);
+    return dot(r, geometric) > 0 ? r : reflect(d, geometric);
+}
+
+std::optional<Vec3> refract_below(const Vec3& d, const Vec3& shading, const Vec3& geometric,
+                                  double eta) {
+    const auto through = refract(d, shading, eta);
+    if (through && dot(*through, geometric) < 0) return through;
+    return refract(d, geometric, eta);
+}
+
+Ray spawn_ray(const Vec3& point, const Vec3& normal, const Vec3& dir, double time) {
+    const double offset = max_abs_component(point) * 0x1.0p-32 + 1e-9;
+    const Vec3 towards = dot(dir, normal) >= 0 ? normal : -normal;
+    return {point + towards * offset, dir, time};
+}
+
+Vec3 perturb_direction(const Vec3& ideal, double sigma, Vec2 u) {
+    // Box-Muller radius: the length of a 2-D normal vector with per-axis deviation sigma.
+    const double theta = sigma * std::sqrt(-2.0 * std::log1p(-u.x));
+    const SinCos phi = sincos_turns(u.y);
+    const double sin_t = std::sin(theta);
+    const Vec3 local{sin_t * phi.cos, sin_t * phi.sin, std::cos(theta)};
+    return normalize(Frame::around(ideal).to_world(local));
+}
+
+Integrator::Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bvh,
+                       const Sampler& sampler)
+    : scene_(scene), plan_(plan), bvh_(bvh), sampler_(sampler), camera_(scene.camera()) {
+    for (const auto& light : scene.lights) {
+        any_visible_light_ = any_visible_light_ || light->visible();
+        if (!light->is_point()) area_lights_.push_back(light.get());
+    }
+}
+
+void Integrator::sample_pixel(int x, int y, const PixelSample& s, std::span<Color> out,
+                              RayCounts& counts) const {
+    PixelWork work{counts, RunPoints(sampler_, s, static_cast<std::uint32_t>(out.size()))};
+    const Effects& e = plan_.effects;
+    std::vector<Vec2> film(out.size(), Vec2{x + 0.5, y + 0.5});
+    if (e.antialiasing) {
+        sampler_.get_2d_run(s, dim::kPixel, film);
+        for (Vec2& f : film) f = {x + f.x, y + f.y};
+    }
+    std::vector<Vec2> lens(out.size(), Vec2{0.5, 0.5});
+    if (e.depth_of_field) sampler_.get_2d_run(s, dim::kLens, lens);
+    PixelSample sample = s;
+    for (std::size_t i = 0; i < out.size(); ++i, ++sample.index) {
+        const double time =
+            e.motion_blur ? sampler_.get_1d(sample, dim::kTime) * plan_.shutter_end : 0.0;
+        ++counts.camera;
+        out[i] = radiance(camera_.generate_ray(film[i], lens[i], time), sample, 0, work);
+    }
+}
+
+Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth,
+                           RayCounts& counts) const {
+    PixelWork work{counts, RunPoints(sampler_, s, 0)};
+    return radiance(ray, s, depth, work);
+}
+
+Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, PixelWork& work) const {
+    const auto hit = bvh_.intersect(ray, {0, kInfinity});
+    if (any_visible_light_) {
+        double nearest = hit ? hit->t : kInfinity;
+        const Light* seen = nullptr;
+        for (const auto& light : scene_.lights) {
+            if (!light->visible()) continue;
+            if (auto t = light->intersect(ray, {0, nearest})) nearest = *t, seen = light.get();
+        }
+        if (seen) return seen->intensity();
+    }
+    if (!hit) return scene_.background;
+
+    const Material& m = hit->object->material();
+    const SurfaceHit surface = hit->object->surface_at(ray, *hit);
+    // Face both normals towards the incoming ray: planes are two-sided, and a ray inside a
+    // sphere sees its inner side.
+    const bool outside = dot(ray.dir, surface.normal) < 0;
+    const Vec3 geometric = outside ? surface.normal : -surface.normal;
+    Vec3 shading = outside ? surface.shading_normal : -surface.shading_normal;
+    if (dot(shading, ray.dir) >= 0) shading = geometric;  // bump tilted it past the viewer
+
+    Color result;
+    if (m.has_diffuse()) {
+        const Vec3 above = outside ? surface.light_normal : -surface.light_normal;
+        const Color light = scene_.ambient + direct_light(surface.light_point, above, shading,
+                                                          ray.time, s, depth, work.counts);
+        result += m.diffuse * surface.kd * light;
+    }
+    if (depth >= scene_.settings.max_depth) return result;  // deeper rays would contribute black
+
+    // The plan says whether directions are perturbed at all, the material by how much.
+    const Effects& e = plan_.effects;
+    if (m.reflects()) {
+        const double reflection_sigma = e.glossy_reflection ? m.sigma() : 0.0;
+        const Vec3 ideal = reflect_above(ray.dir, shading, geometric);
+        result += m.reflective * m.ks *
+                  scattered(surface.point, geometric, ideal, reflection_sigma, +1, ray.time, s,
+                            depth, dim::kGlossReflect, false, work);
+    }
+    if (m.transmits()) {
+        const double sigma = m.sigma();
+        const double reflection_sigma = e.glossy_reflection ? sigma : 0.0;
+        const double refraction_sigma = e.glossy_refraction ? sigma : 0.0;
+        // The medium outside every object is air (index 1), as in the thesis.
+        const double eta = outside ? 1.0 / m.index : m.index;
+        const double cos_i = std::max(0.0, -dot(ray.dir, shading));
+        const double fresnel = fresnel_dielectric(cos_i, eta);
+        Color glass;
+        if (fresnel > 0) {
+            glass +=
+                fresnel * scattered(surface.point, geometric,
+                                    reflect_above(ray.dir, shading, geometric), reflection_sigma,
+                                    +1, ray.time, s, depth, dim::kGlassReflect, false, work);
+        }
+        if (fresnel < 1) {
+            if (const auto through = refract_below(ray.dir, shading, geometric, eta)) {
+                glass += (1.0 - fresnel) * scattered(surface.point, geometric, *through,
+                                                     refraction_sigma, -1, ray.time, s, depth,
+                                                     dim::kGlossRefract, true, work);
+            }
+        }
+        result += m.transmit * m.kt * glass;
+    }
+    return result;
+}
+
+Color Integrator::scattered(const Vec3& point, const Vec3& geometric, const Vec3& ideal,
+                            double sigma, double side, double time, const PixelSample& s, int depth,
+                            std::uint32_t kind, bool refraction, PixelWork& work) const {
+    const std::uint32_t dimension = dim::bounce(depth, kind);
+    const int rays = sigma > 0 && depth == 0 ? scene_.settings.glossy_rays : 1;
+    Color sum;
+    for (int j = 0; j < rays; ++j) {
+        Vec3 dir = ideal;
+        if (sigma > 0) {
+            Vec2 u = rays == 1 ? work.points.get_2d(s, dimension)
+                               : sampler_.get_2d_in_set(s, dimension, j, rays);
+            for (int attempt = 1;; ++attempt) {
+                dir = perturb_direction(ideal, sigma, u);
+                if (side * dot(dir, geometric) > 0) break;
+                if (attempt == kRedrawAttempts) {
+                    dir = ideal;
+                    break;
+                }
+                const std::uint64_t h =
+                    hash_of(s.seed, s.pixel, s.index, dimension, s.path, j, attempt);
+                u = {to_unit(h), to_unit(mix64(h))};
+            }
+        }
+        ++(refraction ? work.counts.refraction : work.counts.reflection);
+        sum += radiance(spawn_ray(point, geometric, dir, time), s.branch(kind, j), depth + 1, work);
+    }
+    return rays == 1 ? sum : sum / rays;
+}
+
+Color Integrator::light_ray(const Light& light, const LightSample& ls, const Vec3& origin,
+                            const Vec3& geometric, const Vec3& shading, double time,
+                            const Occluders& occluders, RayCounts& counts) const {
+    const double cosine = lit_cosine(ls.dir, shading, geometric);
+    if (cosine == 0) return {};  // no ray needed
+    ++counts.shadow;
+    if (occluders.occluded(bvh_, {origin, ls.dir, time}, {0, ls.distance})) return {};
+    return light.intensity() * cosine;
+}
+
+Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const Vec3& shading,
+                               double time, const PixelSample& s, int depth,
+                               RayCounts& counts) const {
+    // Every shadow ray leaves on the geometric normal's side, so from the same spawned origin.
+    const Vec3 origin = spawn_ray(point, geometric, geometric, time).origin;
+    // Points and directions come a chunk at a time, so that what a set shares (its key, the
+    // light's cone) is worked out once rather than once per ray.
+    constexpr int kChunk = 16;
+    std::array<Vec2, kChunk> points;
+    std::array<LightSample, kChunk> samples;
+    std::array<double, kChunk> cosines;
+    Color sum;
+    for (std::size_t i = 0; i < scene_.lights.size(); ++i) {
+        const int rays = plan_.shadow_rays[i];
+        if (rays == 0) continue;
+        const Light& light = *scene_.lights[i];
+        const std::uint32_t dimension = dim::light(depth, i);
+        // What can block this point's rays to this light, found once for all of them when
+        // worth_culling says so (occluders.h), which decides how they are shaded below.
+        const Occluders occluders =
+            worth_culling(rays, bvh_) ? Occluders(bvh_, origin, light.extent(), time) : Occluders{};
+        Color light_sum;
+        for (int first = 0; first < rays; first += kChunk) {
+            const auto n = static_cast<std::size_t>(std::min(kChunk, rays - first));
+            if (!plan_.effects.soft_shadows) {
+                std::fill_n(points.begin(), n, kLightCentre);
+            } else if (rays == 1) {
+                points[0] = sampler_.get_2d(s, dimension);
+            } else {
+                sampler_.get_2d_set(s, dimension, static_cast<std::uint32_t>(rays),
+                                    static_cast<std::uint32_t>(first), std::span(points).first(n));
+            }
+            const auto chunk = std::span<const Vec2>(points).first(n);
+            if (occluders.every_ray_reaches()) {
+                // Every ray reaches the light: only the cosines are needed.
+                light.lit_cosines(point, shading, geometric, chunk, std::span(cosines).first(n));
+                double cosine_sum = 0;
+                for (std::size_t j = 0; j < n; ++j) {
+                    cosine_sum += cosines[j];
+                    counts.shadow += cosines[j] > 0;  // a ray is cast only for a lit direction
+                }
+                light_sum += light.intensity() * cosine_sum;
+                continue;
+            }
+            light.sample(point, chunk, std::span(samples).first(n));
+            for (std::size_t j = 0; j < n; ++j) {
+                light_sum += light_ray(light, samples[j], origin, geometric, shading, time,
+                                       occluders, counts);
+            }
+        }
+        sum += rays == 1 ? light_sum : light_sum / rays;
+    }
+    if (plan_.shared_rays > 0) {
+        // Fewer rays than area lights: each ray picks one in proportion to power (stratified
+        // over the rays), and its contribution is divided by the pick probability.
+        const int rays = plan_.shared_rays;
+        const std::uint32_t dimension = dim::bounce(depth, dim::kLightPick);
+        for (int j = 0; j < rays; ++j) {
+            Vec2 u = rays == 1 ? sampler_.get_2d(s, dimension)
+                               : sampler_.get_2d_in_set(s, dimension, j, rays);
+            const auto& cdf = plan_.light_pick_cdf;
+            const std::size_t k = std::min<std::size_t>(
+                std::upper_bound(cdf.begin(), cdf.end(), u.x) - cdf.begin(), cdf.size() - 1);
+            const double lo = k == 0 ? 0.0 : cdf[k - 1];
+            const double p = cdf[k] - lo;
+            u.x =
+                std::clamp((u.x - lo) / p, 0.0, std::nextafter(1.0, 0.0));  // reuse within the pick
+            if (!plan_.effects.soft_shadows) u = kLightCentre;
+            const Light& light = *area_lights_[k];
+            sum += light_ray(light, light.sample(point, u), origin, geometric, shading, time,
+                             Occluders{}, counts) /
+                   (p * rays);
+        }
+    }
+    return sum;
+}
+
+}  // namespace drt

@@ -1,0 +1,128 @@
+#include "drt/render/render_plan.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+namespace drt {
+
+namespace {
+
+// Splits `total` rays among lights in proportion to `powers`, at least one each, by largest
+// remainder so the counts add up to `total` exactly.
+std::vector<int> share_rays(int total, const std::vector<double>& powers) {
+    const std::size_t n = powers.size();
+    std::vector<int> counts(n, 1);
+    const double sum = std::accumulate(powers.begin(), powers.end(), 0.0);
+    const int spare = total - static_cast<int>(n);
+    if (spare <= 0) return counts;
+    std::vector<double> remainders(n);
+    int given = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double ideal = sum > 0 ? spare * powers[i] / sum : double(spare) / n;
+        counts[i] += static_cast<int>(std::floor(ideal));
+        given += static_cast<int>(std::floor(ideal));
+        remainders[i] = ideal - std::floor(ideal);
+    }
+    std::vector<std::size_t> order(n);
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return remainders[a] > remainders[b]; });
+    for (std::size_t k = 0; given < spare; ++k, ++given) ++counts[order[k % n]];
+    return counts;
+}
+
+}  // namespace
+
+RenderPlan plan_render(const Scene& scene) {
+    RenderPlan plan;
+    const RenderSettings& s = scene.settings;
+    Effects& e = plan.effects;
+    e.antialiasing = s.samples > 1;
+    e.depth_of_field = !scene.lens.is_pinhole();
+    plan.shutter_end = scene.shutter_end();
+    e.motion_blur = plan.shutter_end > 0;
+
+    bool diffuse_used = false;
+    for (const auto& object : scene.objects) {
+        const Material& m = object->material();
+        diffuse_used = diffuse_used || m.has_diffuse();
+        if (s.max_depth > 0 && m.is_glossy()) {
+            // Glass reflects part of the light too, so a glossy transparent material also
+            // perturbs reflections.
+            e.glossy_reflection = e.glossy_reflection || m.reflects() || m.transmits();
+            e.glossy_refraction = e.glossy_refraction || m.transmits();
+        }
+    }
+
+    std::vector<double> area_powers;
+    for (const auto& light : scene.lights) {
+        if (!light->is_point()) area_powers.push_back(std::max(0.0, light->power()));
+    }
+    e.soft_shadows = diffuse_used && !area_powers.empty();
+
+    const int area_count = static_cast<int>(area_powers.size());
+    std::vector<int> area_rays;
+    if (area_count > 0 && s.shadow_rays >= area_count) {
+        area_rays = share_rays(s.shadow_rays, area_powers);
+    } else if (area_count > 0) {
+        plan.shared_rays = s.shadow_rays;
+        area_rays.assign(area_powers.size(), 0);
+        const double sum = std::accumulate(area_powers.begin(), area_powers.end(), 0.0);
+        double running = 0;
+        for (double p : area_powers) {
+            running += sum > 0 ? p / sum : 1.0 / area_count;
+            plan.light_pick_cdf.push_back(running);
+        }
+        plan.light_pick_cdf.back() = 1.0;
+    }
+    std::size_t next_area = 0;
+    for (const auto& light : scene.lights) {
+        plan.shadow_rays.push_back(light->is_point() ? 1 : area_rays[next_area++]);
+    }
+    return plan;
+}
+
+std::string describe(const Scene& scene, const RenderPlan& plan) {
+    const RenderSettings& s = scene.settings;
+    std::ostringstream out;
+    std::size_t moving = 0;
+    for (const auto& object : scene.objects) moving += object->moves() ? 1 : 0;
+    out << "scene: " << scene.path << "\n"
+        << "image: " << s.width << "x" << s.height << "\n"
+        << "samples per pixel: " << s.samples << "\n"
+        << "shadow rays: " << s.shadow_rays << "\n"
+        << "max depth: " << s.max_depth << "\n"
+        << "glossy rays: " << s.glossy_rays << "\n"
+        << "seed: " << s.seed << "\n"
+        << "sampler: " << s.sampler << "\n"
+        << "camera: " << (scene.view ? "look-at" : "thesis pixel plane")
+        << (scene.lens.is_pinhole() ? ", pinhole" : ", thin lens") << "\n"
+        << "materials: " << scene.materials.size() << "\n"
+        << "objects: " << scene.objects.size() << " (" << moving << " moving)\n"
+        << "lights: " << scene.lights.size() << "\n";
+    for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+        out << "  light " << i << ": " << (scene.lights[i]->is_point() ? "point" : "sphere")
+            << ", power " << scene.lights[i]->power() << ", shadow rays per shading point "
+            << plan.shadow_rays[i] << "\n";
+    }
+    if (plan.shared_rays > 0) {
+        out << "  fewer shadow rays than area lights: each of " << plan.shared_rays
+            << " rays picks an area light in proportion to power\n";
+    }
+    const Effects& e = plan.effects;
+    auto flag = [](bool on) { return on ? "sampled" : "off"; };
+    out << "effects:\n"
+        << "  antialiasing: " << flag(e.antialiasing) << "\n"
+        << "  soft_shadows: " << flag(e.soft_shadows) << "\n"
+        << "  glossy_reflection: " << flag(e.glossy_reflection) << "\n"
+        << "  glossy_refraction: " << flag(e.glossy_refraction) << "\n"
+        << "  depth_of_field: " << flag(e.depth_of_field) << "\n"
+        << "  motion_blur: " << flag(e.motion_blur);
+    if (e.motion_blur) out << " (shutter 0.." << plan.shutter_end << ")";
+    out << "\n";
+    return out.str();
+}
+
+}  // namespace drt

@@ -1,0 +1,95 @@
+#include "drt/render/renderer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <functional>
+
+#include "drt/util/limits.h"
+#include "drt/util/parallel.h"
+
+namespace drt {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+int render_tiles(const RenderContext& context, TileSource& source, TileSink& sink,
+                 const RenderOptions& options) {
+    const int threads =
+        std::max(1, std::min(worker_threads(options.threads), static_cast<int>(source.size())));
+    std::atomic<std::size_t> tiles_done{0};
+    const double total = static_cast<double>(std::max<std::size_t>(1, source.size()));
+    const auto progress = [&] { options.on_progress(double(tiles_done.load()) / total); };
+    run_on_threads(
+        threads,
+        [&](const std::atomic<bool>& failed) {
+            while (!failed.load(std::memory_order_relaxed) && !options.stop.stop_requested()) {
+                const std::optional<Tile> tile = source.next();
+                if (!tile) break;
+                sink.add(context.render_tile(*tile));
+                tiles_done.fetch_add(1, std::memory_order_relaxed);
+            }
+        },
+        options.on_progress ? std::function<void()>(progress) : nullptr);
+    if (options.on_progress) progress();
+    return threads;
+}
+
+RenderResult render(const RenderContext& context, ImageSink& sink, const RenderOptions& options) {
+    const auto start = Clock::now();
+    TileQueue source(sink.missing());
+    RenderOptions run = options;
+    if (options.on_progress) {
+        // Progress over the whole image, counting the tiles the sink already had.
+        const double all = double(std::max<std::size_t>(1, sink.tile_count()));
+        const double before = double(sink.tiles_done()) / all;
+        const double share = double(source.size()) / all;
+        run.on_progress = [&, before, share](double done) {
+            options.on_progress(before + share * done);
+        };
+    }
+    const int threads = render_tiles(context, source, sink, run);
+    RenderResult result = assembled(context, sink);
+    result.stats.threads = threads;
+    result.stats.seconds = seconds_since(start);
+    return result;
+}
+
+RenderResult assembled(const RenderContext& context, const ImageSink& sink) {
+    RenderResult result;
+    result.image = sink.image();
+    result.plan = context.plan();
+    result.stats.adaptive = context.adaptive();
+    if (context.adaptive()) result.pixel_samples = sink.pixel_samples();
+    result.stats.rays = sink.rays();
+    result.stats.samples = sink.samples();
+    result.stats.pixels_converged = sink.converged();
+    result.unfinished = sink.missing();
+    result.spread = sink.spread();
+    if (result.unfinished.empty()) {
+        result.stats.error = estimate_error(result.image, result.spread, sink.error_sums(),
+                                            sink.samples(), context.scene().settings.samples,
+                                            context.spread_kind(), context.rendered_pixels());
+    } else {
+        result.stats.error.unavailable = "the render is unfinished";
+    }
+    return result;
+}
+
+RenderResult render(const Scene& scene, const RenderOptions& options) {
+    const auto start = Clock::now();
+    const RenderContext context(scene, options.adaptive);
+    ImageSink sink(scene.settings.width, scene.settings.height, context.tiles());
+    RenderResult result = render(context, sink, options);
+    result.stats.seconds = seconds_since(start);
+    return result;
+}
+
+}  // namespace drt

@@ -1,0 +1,50 @@
+#include "drt/scene/render_limits.h"
+
+#include <algorithm>
+
+#include "drt/util/limits.h"
+
+namespace drt {
+
+std::uint64_t estimated_render_bytes(const RenderSettings& settings, int threads) {
+    const std::uint64_t pixels =
+        std::uint64_t(std::max(settings.width, 0)) * std::uint64_t(std::max(settings.height, 0));
+    const std::uint64_t samples = std::uint64_t(std::max(settings.samples, 0));
+    return pixels * kBytesPerPixel +
+           std::uint64_t(std::max(threads, 1)) * samples * kBytesPerSample;
+}
+
+std::optional<std::string> render_limit_problem(const RenderSettings& s, int threads) {
+    const auto over = [](const std::string& what, std::uint64_t value, std::uint64_t limit) {
+        return what + " " + std::to_string(value) + " exceeds the limit of " +
+               std::to_string(limit);
+    };
+    if (s.width > kMaxImageSide || s.height > kMaxImageSide) {
+        return "image size " + std::to_string(s.width) + "x" + std::to_string(s.height) +
+               " exceeds the limit of " + std::to_string(kMaxImageSide) + " pixels a side";
+    }
+    const std::uint64_t pixels = std::uint64_t(s.width) * std::uint64_t(s.height);
+    if (pixels > kMaxPixels) {
+        return "image size " + std::to_string(s.width) + "x" + std::to_string(s.height) + " (" +
+               std::to_string(pixels) + " pixels) exceeds the limit of " +
+               std::to_string(kMaxPixels) + " pixels";
+    }
+    if (s.samples > kMaxSamples) return over("samples per pixel", s.samples, kMaxSamples);
+    if (s.shadow_rays > kMaxRaysPerPoint)
+        return over("shadow rays", s.shadow_rays, kMaxRaysPerPoint);
+    if (s.glossy_rays > kMaxRaysPerPoint)
+        return over("glossy rays", s.glossy_rays, kMaxRaysPerPoint);
+    if (s.max_depth > kMaxDepthLimit) return over("max depth", s.max_depth, kMaxDepthLimit);
+    const int workers = worker_threads(threads);
+    const std::uint64_t bytes = estimated_render_bytes(s, workers);
+    if (bytes > kMemoryBudget) {
+        return "the render needs an estimated " + std::to_string(bytes >> 20) + " MiB (" +
+               std::to_string(pixels) + " pixels x " + std::to_string(kBytesPerPixel) + " B + " +
+               std::to_string(workers) + " threads x " + std::to_string(s.samples) + " samples x " +
+               std::to_string(kBytesPerSample) + " B), more than the " +
+               std::to_string(kMemoryBudget >> 20) + " MiB budget";
+    }
+    return std::nullopt;
+}
+
+}  // namespace drt

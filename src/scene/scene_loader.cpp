@@ -1,0 +1,831 @@
+// The scene file reader. Every element and attribute of ../shared/spec/scene-format.md is read
+// here, checked, and turned into the Scene the renderer uses; docs/scene-format.md is the
+// user-facing description of the same rules.
+//
+// Loading takes two passes because a thesis scene may define materials after the objects that
+// use them: the first pass reads everything and keeps objects pending, the second resolves
+// their material names and builds them.
+#include "drt/scene/scene_loader.h"
+
+#include <tinyxml2.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <system_error>
+#include <type_traits>
+#include <vector>
+
+#include "drt/accel/mesh.h"
+#include "drt/geometry/plane.h"
+#include "drt/geometry/sphere.h"
+#include "drt/io/obj_reader.h"
+#include "drt/sampling/sampler.h"
+#include "drt/shading/texture.h"
+#include "drt/util/limits.h"
+#include "drt/util/text.h"
+
+namespace drt {
+
+namespace {
+
+using tinyxml2::XMLElement;
+
+// ---------------------------------------------------------------------------------------------
+// Suggestions for misspelt names.
+
+// Optimal-string-alignment distance: insertions, deletions, substitutions and swaps of two
+// neighbours each cost one, since a swap ("Nmae") is as common a typo as a wrong letter. Case is
+// ignored, so that "radius" finds "Radius" and "bumpenable" finds "bumpEnable".
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+    const auto same = [](char x, char y) {
+        return std::tolower(static_cast<unsigned char>(x)) ==
+               std::tolower(static_cast<unsigned char>(y));
+    };
+    const std::size_t w = b.size() + 1;
+    std::vector<std::size_t> d((a.size() + 1) * w);
+    for (std::size_t i = 0; i <= a.size(); ++i) d[i * w] = i;
+    for (std::size_t j = 0; j <= b.size(); ++j) d[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            std::size_t best =
+                std::min({d[(i - 1) * w + j] + 1, d[i * w + j - 1] + 1,
+                          d[(i - 1) * w + j - 1] + (same(a[i - 1], b[j - 1]) ? 0 : 1)});
+            if (i > 1 && j > 1 && same(a[i - 1], b[j - 2]) && same(a[i - 2], b[j - 1])) {
+                best = std::min(best, d[(i - 2) * w + j - 2] + 1);
+            }
+            d[i * w + j] = best;
+        }
+    }
+    return d[a.size() * w + b.size()];
+}
+
+// The known name closest to `name`, when it is close enough to be what the user meant: about
+// one edit per three characters, so "Radus" gets "Radius" but "Teapot" gets nothing.
+std::optional<std::string_view> nearest(std::string_view name,
+                                        std::span<const std::string_view> known) {
+    const std::size_t allowed = (name.size() + 2) / 3;
+    std::optional<std::string_view> best;
+    std::size_t best_distance = allowed + 1;
+    for (const std::string_view candidate : known) {
+        const std::size_t d = edit_distance(name, candidate);
+        if (d < best_distance) best = candidate, best_distance = d;
+    }
+    return best;
+}
+
+// Every element the format knows, wherever it may stand; an element from this list in the wrong
+// place is reported as misplaced rather than unknown.
+constexpr std::string_view kElementNames[] = {
+    "Scene",     "Image",    "Render",  "Background", "Ambient", "Camera", "DepthOfField",
+    "Materials", "Lights",   "Objects", "Light",      "Plane",   "Sphere", "MotionBlurPosition",
+    "Material",  "Triangle", "Mesh",
+};
+
+// ---------------------------------------------------------------------------------------------
+// Numbers: the whole (trimmed) attribute value must be one finite number.
+
+std::string_view trim(std::string_view s) {
+    constexpr std::string_view kSpace = " \t\r\n";
+    const std::size_t first = s.find_first_not_of(kSpace);
+    if (first == std::string_view::npos) return {};
+    return s.substr(first, s.find_last_not_of(kSpace) - first + 1);
+}
+
+// std::errc{} on success; invalid_argument for anything that is not wholly a finite number of
+// type T; result_out_of_range when it is one but T cannot hold it.
+template <class T>
+std::errc parse_whole(std::string_view text, T& out) {
+    // from_chars rejects a leading '+', which people write; "+-1" must stay an error.
+    if (!text.empty() && text.front() == '+') {
+        text.remove_prefix(1);
+        if (!text.empty() && text.front() == '-') return std::errc::invalid_argument;
+    }
+    const char* end = text.data() + text.size();
+    const auto [ptr, ec] = std::from_chars(text.data(), end, out);
+    if (ec != std::errc{}) return ec;
+    if (ptr != end) return std::errc::invalid_argument;
+    if constexpr (std::is_floating_point_v<T>) {
+        if (!std::isfinite(out)) return std::errc::invalid_argument;  // "inf", "nan"
+    }
+    return {};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Where messages go.
+
+class Context {
+  public:
+    explicit Context(std::string file) : file_(std::move(file)) {}
+
+    [[noreturn]] void fail(const XMLElement& element, const std::string& message) const {
+        fail_at(element.GetLineNum(), element.Name(), message);
+    }
+    [[noreturn]] void fail_at(int line, std::string_view element,
+                              const std::string& message) const {
+        throw SceneError(printable(file_ + ":" + std::to_string(std::max(line, 1)) + ": " +
+                                   std::string(element) + ": " + message));
+    }
+    void warn(const XMLElement& element, const std::string& message) {
+        warnings_.push_back(printable(file_ + ":" + std::to_string(element.GetLineNum()) +
+                                      ": warning: " + message));
+    }
+    void warn_unknown_element(const XMLElement& element, const XMLElement& parent,
+                              std::span<const std::string_view> allowed) {
+        const std::string_view name = element.Name();
+        if (std::ranges::find(kElementNames, name) != std::end(kElementNames)) {
+            warn(element,
+                 "<" + std::string(name) + "> does not belong in <" + parent.Name() + ">; ignored");
+            return;
+        }
+        std::string message = "unknown element <" + std::string(name) + ">";
+        if (const auto guess = nearest(name, allowed))
+            message += "; did you mean <" + std::string(*guess) + ">?";
+        warn(element, message);
+    }
+
+    const std::string& file() const { return file_; }
+    std::vector<std::string> take_warnings() { return std::move(warnings_); }
+
+  private:
+    std::string file_;
+    std::vector<std::string> warnings_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// The attributes of one element. Every accessor records the name it was asked for, so after an
+// element has been read completely, the recorded names are exactly the attributes it knows:
+// anything else on the element is unknown, and the recorded names are the suggestions.
+
+class Attributes {
+  public:
+    Attributes(const XMLElement& element, Context& context)
+        : element_(element), context_(context) {}
+
+    [[noreturn]] void fail(const std::string& message) const { context_.fail(element_, message); }
+
+    std::optional<std::string_view> find(std::string_view name) {
+        known_.push_back(name);
+        const char* value = element_.Attribute(std::string(name).c_str());
+        return value ? std::optional<std::string_view>(value) : std::nullopt;
+    }
+
+    std::string text(std::string_view name) {
+        if (const auto value = find(name)) return std::string(*value);
+        fail_missing(name);
+    }
+    std::string text(std::string_view name, std::string_view fallback) {
+        return std::string(find(name).value_or(fallback));
+    }
+
+    std::optional<double> optional_number(std::string_view name) {
+        const auto value = find(name);
+        if (!value) return std::nullopt;
+        return convert<double>(name, *value, "a number");
+    }
+    double number(std::string_view name) {
+        if (const auto value = optional_number(name)) return *value;
+        fail_missing(name);
+    }
+    double number(std::string_view name, double fallback) {
+        return optional_number(name).value_or(fallback);
+    }
+    Vec3 vec3(std::string_view x, std::string_view y, std::string_view z) {
+        return {number(x), number(y), number(z)};
+    }
+    Vec3 vec3(std::string_view x, std::string_view y, std::string_view z, Vec3 fallback) {
+        return {number(x, fallback.x), number(y, fallback.y), number(z, fallback.z)};
+    }
+    Color color(std::string_view r, std::string_view g, std::string_view b, Color fallback) {
+        return {number(r, fallback.r), number(g, fallback.g), number(b, fallback.b)};
+    }
+
+    template <class Int>
+    Int integer(std::string_view name, Int fallback) {
+        const auto value = find(name);
+        if (!value) return fallback;
+        return convert<Int>(name, *value,
+                            std::is_signed_v<Int> ? "an integer" : "a non-negative integer");
+    }
+    bool flag(std::string_view name, bool fallback) {
+        const auto value = find(name);
+        if (!value) return fallback;
+        const std::string_view t = trim(*value);
+        if (t != "0" && t != "1") {
+            fail(std::string(name) + " must be 0 or 1, got \"" + abbreviated(*value) + "\"");
+        }
+        return t == "1";
+    }
+
+    // Fails with "NAME must be RULE, got VALUE" unless `ok`.
+    void check(bool ok, std::string_view name, std::string_view rule) const {
+        if (!ok) fail(std::string(name) + " must be " + std::string(rule) + ", got " + shown(name));
+    }
+    // The attribute's value as the user wrote it, for messages.
+    std::string shown(std::string_view name) const {
+        const char* value = element_.Attribute(std::string(name).c_str());
+        return value ? abbreviated(trim(value)) : "(default)";
+    }
+
+    // Call once the element has been read completely.
+    void warn_unknown() {
+        for (const auto* a = element_.FirstAttribute(); a; a = a->Next()) {
+            const std::string_view name = a->Name();
+            if (std::ranges::find(known_, name) != known_.end()) continue;
+            std::string message =
+                "unknown attribute " + quoted(name) + " on <" + element_.Name() + ">";
+            if (const auto guess = nearest(name, known_))
+                message += "; did you mean " + quoted(*guess) + "?";
+            context_.warn(element_, message);
+        }
+    }
+
+  private:
+    static std::string quoted(std::string_view name) {
+        std::string text(1, '\'');
+        text.append(name);
+        text += '\'';
+        return text;
+    }
+
+    [[noreturn]] void fail_missing(std::string_view name) const {
+        fail("missing required attribute " + quoted(name));
+    }
+
+    template <class T>
+    T convert(std::string_view name, std::string_view value, std::string_view kind) const {
+        T out{};
+        const std::errc ec = parse_whole(trim(value), out);
+        if (ec == std::errc{}) return out;
+        const std::string problem = ec == std::errc::result_out_of_range
+                                        ? "is out of range"
+                                        : "is not " + std::string(kind);
+        fail("attribute " + quoted(name) + " " + problem + ": \"" + abbreviated(value) + "\"");
+    }
+
+    const XMLElement& element_;
+    Context& context_;
+    std::vector<std::string_view> known_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Texture and bump mapping, common to planes and spheres. The texture needs the material's kd,
+// which may not be known until every material has been read.
+
+struct SurfaceSpec {
+    bool textured = false;
+    std::string texture;
+    double texture_scale = 50;
+    Color k2{0.1, 0.1, 0.1};
+    std::optional<BumpMap> bump;
+
+    SurfaceDetail build(const Material& material) const {
+        SurfaceDetail detail;
+        if (textured) detail.texture = make_texture(texture, material.kd, k2, texture_scale);
+        detail.bump = bump;
+        return detail;
+    }
+};
+
+SurfaceSpec read_surface(Attributes& in) {
+    SurfaceSpec s;
+    s.textured = in.flag("EnableTexture", false);
+    s.texture = in.text("Texture", "checker");
+    s.texture_scale = in.number("TextureScale", 50);
+    in.check(s.texture_scale > 0, "TextureScale", "positive");
+    s.k2 = in.color("k2r", "k2g", "k2b", {0.1, 0.1, 0.1});
+    // Checked even when disabled, so that a misspelt name does not wait to be found until the
+    // texture is switched on.
+    if (!make_texture(s.texture, {}, {}, 1))
+        in.fail("unknown texture '" + abbreviated(s.texture) + "'");
+
+    const bool bumped = in.flag("bumpEnable", false);
+    BumpMap bump;
+    bump.scale = in.number("BumpScale", bump.scale);
+    in.check(bump.scale > 0, "BumpScale", "positive");
+    bump.strength = in.number("BumpStrength", bump.strength);
+    if (bumped) s.bump = bump;
+    return s;
+}
+
+// The rule of a limit from limits.h, for Attributes::check: "Width must be at most 65536, got ...".
+std::string at_most(int limit) {
+    return "at most " + std::to_string(limit);
+}
+
+// Scales a vector so its largest component is ±1: normalising that is safe for any finite
+// input, where normalising a vector of tiny or huge components would underflow or overflow.
+std::optional<Vec3> direction(const Vec3& v) {
+    const double m = max_abs_component(v);
+    if (!(m > 0) || !std::isfinite(m)) return std::nullopt;
+    return normalize(v / m);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The reader proper.
+
+class SceneReader {
+  public:
+    explicit SceneReader(std::string file) : context_(std::move(file)) {}
+
+    LoadedScene read(std::string_view xml) {
+        tinyxml2::XMLDocument doc;
+        parse_xml(xml, doc);
+        const XMLElement& root = root_element(doc);
+        scene_.path = context_.file();
+        read_scene(root);
+        resolve_objects();
+        return {std::move(scene_), context_.take_warnings(), std::move(files_read_)};
+    }
+
+  private:
+    using Handler = void (SceneReader::*)(const XMLElement&);
+    struct Child {
+        std::string_view name;
+        Handler read;
+        bool setting = false;  // stands once per scene; a repeat overrides and is warned about
+    };
+
+    // An object read but not yet built: its material may be defined further down the file.
+    struct PendingObject {
+        const XMLElement* element;  // for messages; the document outlives resolution
+        std::string material;
+        SurfaceSpec surface;
+        std::function<std::unique_ptr<Object>(const Material&, SurfaceDetail)> make;
+    };
+
+    void parse_xml(std::string_view xml, tinyxml2::XMLDocument& doc) const {
+        // tinyxml2 silently stops at a nul byte, which would read half a binary file as a scene.
+        if (const std::size_t nul = xml.find('\0'); nul != std::string_view::npos) {
+            const auto line =
+                1 + std::count(xml.begin(), xml.begin() + static_cast<std::ptrdiff_t>(nul), '\n');
+            context_.fail_at(static_cast<int>(line), "XML", "nul byte in input (not a text file?)");
+        }
+        if (const auto error = doc.Parse(xml.data(), xml.size()); error != tinyxml2::XML_SUCCESS) {
+            context_.fail_at(doc.ErrorLineNum(), "XML", describe(error));
+        }
+    }
+
+    static std::string describe(tinyxml2::XMLError error) {
+        switch (error) {
+            case tinyxml2::XML_ERROR_EMPTY_DOCUMENT:
+                return "empty document";
+            case tinyxml2::XML_ERROR_MISMATCHED_ELEMENT:
+                return "mismatched end tag";
+            case tinyxml2::XML_ERROR_PARSING_ELEMENT:
+                return "malformed element";
+            case tinyxml2::XML_ERROR_PARSING_ATTRIBUTE:
+                return "malformed or repeated attribute";
+            case tinyxml2::XML_ERROR_PARSING_TEXT:
+                return "text outside the root element";
+            case tinyxml2::XML_ERROR_PARSING_CDATA:
+                return "malformed cdata section";
+            case tinyxml2::XML_ERROR_PARSING_COMMENT:
+                return "malformed comment";
+            case tinyxml2::XML_ERROR_PARSING_DECLARATION:
+                return "malformed declaration";
+            case tinyxml2::XML_ERROR_PARSING_UNKNOWN:
+                return "malformed markup";
+            case tinyxml2::XML_ELEMENT_DEPTH_EXCEEDED:
+                return "elements nested too deeply";
+            default:
+                return "malformed xml";
+        }
+    }
+
+    const XMLElement& root_element(const tinyxml2::XMLDocument& doc) const {
+        const XMLElement* root = doc.RootElement();
+        if (!root) context_.fail_at(1, "XML", "no <Scene> element");
+        if (std::string_view(root->Name()) != "Scene")
+            context_.fail(*root, "root element must be <Scene>");
+        // tinyxml2 accepts several top-level elements; XML does not, and the rest would be lost.
+        if (const XMLElement* extra = root->NextSiblingElement()) {
+            context_.fail(*extra, "second root element after <Scene>");
+        }
+        return *root;
+    }
+
+    void read_children(const XMLElement& parent, std::span<const Child> children) {
+        warn_stray_text(parent);
+        std::vector<std::string_view> names;
+        for (const Child& c : children) names.push_back(c.name);
+        for (const XMLElement* e = parent.FirstChildElement(); e; e = e->NextSiblingElement()) {
+            const auto child =
+                std::ranges::find(children, std::string_view(e->Name()), &Child::name);
+            if (child == children.end()) {
+                context_.warn_unknown_element(*e, parent, names);
+                continue;
+            }
+            if (child->setting) note_setting(*e);
+            (this->*child->read)(*e);
+        }
+    }
+
+    // Every value lives in an attribute, so text such as <Image>600</Image> means a mistake.
+    void warn_stray_text(const XMLElement& e) {
+        for (const tinyxml2::XMLNode* n = e.FirstChild(); n; n = n->NextSibling()) {
+            const tinyxml2::XMLText* text = n->ToText();
+            if (text && !trim(text->Value()).empty()) {
+                context_.warn(e, "text inside <" + std::string(e.Name()) + "> ignored");
+                return;
+            }
+        }
+    }
+
+    void note_setting(const XMLElement& e) {
+        const auto [it, first] = setting_lines_.try_emplace(e.Name(), e.GetLineNum());
+        if (!first) {
+            context_.warn(e, "<" + std::string(e.Name()) + "> repeated; this one overrides line " +
+                                 std::to_string(it->second));
+            it->second = e.GetLineNum();
+        }
+    }
+
+    // A leaf element has no children; any there are ignored, with a warning.
+    void warn_children(const XMLElement& e) { read_children(e, {}); }
+
+    void read_scene(const XMLElement& e) {
+        static constexpr Child kChildren[] = {
+            {"Image", &SceneReader::read_image, true},
+            {"Render", &SceneReader::read_render, true},
+            {"Background", &SceneReader::read_background, true},
+            {"Ambient", &SceneReader::read_ambient, true},
+            {"Camera", &SceneReader::read_camera, true},
+            {"DepthOfField", &SceneReader::read_depth_of_field, true},
+            {"Materials", &SceneReader::read_materials},
+            {"Lights", &SceneReader::read_group},
+            {"Objects", &SceneReader::read_group},
+            {"Light", &SceneReader::read_light},
+            {"Plane", &SceneReader::read_plane},
+            {"Sphere", &SceneReader::read_sphere},
+            {"Triangle", &SceneReader::read_triangle},
+            {"Mesh", &SceneReader::read_mesh},
+        };
+        Attributes in(e, context_);
+        in.warn_unknown();
+        read_children(e, kChildren);
+    }
+
+    // <Lights> and <Objects> only group; either may hold any light or object.
+    void read_group(const XMLElement& e) {
+        static constexpr Child kChildren[] = {
+            {"Light", &SceneReader::read_light},   {"Plane", &SceneReader::read_plane},
+            {"Sphere", &SceneReader::read_sphere}, {"Triangle", &SceneReader::read_triangle},
+            {"Mesh", &SceneReader::read_mesh},
+        };
+        Attributes in(e, context_);
+        in.warn_unknown();
+        read_children(e, kChildren);
+    }
+
+    // --- settings ---
+
+    void read_image(const XMLElement& e) {
+        Attributes in(e, context_);
+        RenderSettings& s = scene_.settings;
+        s.width = in.integer("Width", s.width);
+        in.check(s.width > 0, "Width", "positive");
+        in.check(s.width <= kMaxImageSide, "Width", at_most(kMaxImageSide));
+        s.height = in.integer("Height", s.height);
+        in.check(s.height > 0, "Height", "positive");
+        in.check(s.height <= kMaxImageSide, "Height", at_most(kMaxImageSide));
+        if (std::uint64_t(s.width) * std::uint64_t(s.height) > kMaxPixels) {
+            in.fail("image of " + std::to_string(s.width) + "x" + std::to_string(s.height) +
+                    " pixels exceeds the limit of " + std::to_string(kMaxPixels) +
+                    " pixels (docs/scene-format.md#limits)");
+        }
+        in.warn_unknown();
+        warn_children(e);
+    }
+
+    void read_render(const XMLElement& e) {
+        Attributes in(e, context_);
+        RenderSettings& s = scene_.settings;
+        s.samples = in.integer("Samples", s.samples);
+        in.check(s.samples > 0, "Samples", "positive");
+        in.check(s.samples <= kMaxSamples, "Samples", at_most(kMaxSamples));
+        s.shadow_rays = in.integer("ShadowRays", s.shadow_rays);
+        in.check(s.shadow_rays > 0, "ShadowRays", "positive");
+        in.check(s.shadow_rays <= kMaxRaysPerPoint, "ShadowRays", at_most(kMaxRaysPerPoint));
+        s.max_depth = in.integer("MaxDepth", s.max_depth);
+        in.check(s.max_depth >= 0, "MaxDepth", "non-negative");
+        in.check(s.max_depth <= kMaxDepthLimit, "MaxDepth", at_most(kMaxDepthLimit));
+        s.glossy_rays = in.integer("GlossyRays", s.glossy_rays);
+        in.check(s.glossy_rays > 0, "GlossyRays", "positive");
+        in.check(s.glossy_rays <= kMaxRaysPerPoint, "GlossyRays", at_most(kMaxRaysPerPoint));
+        s.seed = in.integer("Seed", s.seed);
+        s.sampler = in.text("Sampler", s.sampler);
+        if (!make_sampler(s.sampler))
+            in.fail("unknown sampler '" + abbreviated(s.sampler) + "'; known: " + sampler_list());
+        in.warn_unknown();
+        warn_children(e);
+    }
+
+    static std::string sampler_list() {
+        std::string list;
+        for (const std::string& name : sampler_names()) list += (list.empty() ? "" : ", ") + name;
+        return list;
+    }
+
+    void read_background(const XMLElement& e) { scene_.background = read_rgb(e); }
+    void read_ambient(const XMLElement& e) { scene_.ambient = read_rgb(e); }
+
+    Color read_rgb(const XMLElement& e) {
+        Attributes in(e, context_);
+        const Color c = in.color("r", "g", "b", {0, 0, 0});
+        in.warn_unknown();
+        warn_children(e);
+        return c;
+    }
+
+    void read_camera(const XMLElement& e) {
+        Attributes in(e, context_);
+        LookAt view;
+        view.eye = in.vec3("Ex", "Ey", "Ez");
+        view.target = in.vec3("Lx", "Ly", "Lz");
+        view.up = in.vec3("Ux", "Uy", "Uz", view.up);
+        view.fov_degrees = in.number("Fov", view.fov_degrees);
+        in.check(view.fov_degrees > 0 && view.fov_degrees < 180, "Fov", "between 0 and 180");
+        const auto forward = direction(view.target - view.eye);
+        if (!forward) in.fail("eye and look-at point coincide");
+        const auto up = direction(view.up);
+        if (!up || length(cross(*up, *forward)) < 1e-9)
+            in.fail("up is parallel to the view direction");
+        in.warn_unknown();
+        warn_children(e);
+        scene_.view = view;
+    }
+
+    void read_depth_of_field(const XMLElement& e) {
+        Attributes in(e, context_);
+        Lens lens;
+        lens.radius = in.number("Radius");
+        if (lens.radius < 0) in.fail("negative radius " + in.shown("Radius"));
+        lens.focal = in.number("Focal");
+        in.check(lens.focal > 0, "Focal", "positive");
+        in.warn_unknown();
+        warn_children(e);
+        scene_.lens = lens;
+    }
+
+    // --- materials ---
+
+    void read_materials(const XMLElement& e) {
+        Attributes in(e, context_);
+        in.warn_unknown();
+        warn_stray_text(e);
+        // Every child is a material: its tag is its name, so no child is an unknown element.
+        for (const XMLElement* m = e.FirstChildElement(); m; m = m->NextSiblingElement()) {
+            read_material(*m);
+        }
+    }
+
+    void read_material(const XMLElement& e) {
+        Attributes in(e, context_);
+        auto m = std::make_unique<Material>();
+        m->name = std::string_view(e.Name()) == "Material" ? in.text("Name") : e.Name();
+        m->diffuse = in.number("diffuse", m->diffuse);
+        m->kd = in.color("kdr", "kdg", "kdb", m->kd);
+        m->reflective = in.number("reflective", m->reflective);
+        m->ks = in.color("ksr", "ksg", "ksb", m->ks);
+        m->transmit = read_transmit(in, m->transmit);
+        m->kt = in.color("ktr", "ktg", "ktb", m->kt);
+        m->index = in.number("index", m->index);
+        in.check(m->index > 0, "index", "positive");
+        if (const auto n = in.optional_number("n")) {
+            in.check(*n > 0, "n", "positive");
+            m->sharpness = *n;
+        }
+        in.warn_unknown();
+        warn_children(e);
+
+        const auto [it, first] = material_lines_.try_emplace(m->name, e.GetLineNum());
+        if (!first) {
+            in.fail("duplicate material '" + abbreviated(m->name) + "' (first defined on line " +
+                    std::to_string(it->second) + ")");
+        }
+        scene_.materials.push_back(std::move(m));
+    }
+
+    // The thesis spells it "transmitt"; the single-t spelling is accepted too, but not both.
+    static double read_transmit(Attributes& in, double fallback) {
+        const bool thesis = in.find("transmitt").has_value();
+        const bool plain = in.find("transmit").has_value();
+        if (thesis && plain) in.fail("give 'transmitt' or 'transmit', not both");
+        return in.number(plain ? "transmit" : "transmitt", fallback);
+    }
+
+    // --- lights ---
+
+    void read_light(const XMLElement& e) {
+        Attributes in(e, context_);
+        const Vec3 position = in.vec3("Px", "Py", "Pz");
+        const double radius = in.number("Radius", 0);
+        if (radius < 0) in.fail("negative radius " + in.shown("Radius"));
+        const Color intensity = in.color("Ir", "Ig", "Ib", {1, 1, 1});
+        const bool visible = in.flag("Visible", false);
+        in.warn_unknown();
+        warn_children(e);
+        if (radius == 0) {
+            if (visible)
+                context_.warn(e, "a point light (Radius 0) cannot be visible; Visible ignored");
+            scene_.lights.push_back(std::make_unique<PointLight>(position, intensity));
+        } else {
+            scene_.lights.push_back(
+                std::make_unique<SphereLight>(position, radius, intensity, visible));
+        }
+    }
+
+    // --- objects ---
+
+    void read_plane(const XMLElement& e) {
+        Attributes in(e, context_);
+        const Vec3 point = in.vec3("Px", "Py", "Pz");
+        const auto normal = direction(in.vec3("Vu", "Vv", "Vw"));
+        if (!normal) in.fail("zero-length normal");
+        std::string material = in.text("Material");
+        SurfaceSpec surface = read_surface(in);
+        in.warn_unknown();
+        warn_children(e);
+        pending_.push_back({&e, std::move(material), std::move(surface),
+                            [point, n = *normal](const Material& m, SurfaceDetail d) {
+                                return std::make_unique<Plane>(point, n, m, std::move(d));
+                            }});
+    }
+
+    // The <MotionBlurPosition> children of a sphere (Px Py Pz) or mesh (Tx Ty Tz), appended to
+    // its path; anything else inside is warned about.
+    void read_motion(const XMLElement& e, std::string_view x, std::string_view y,
+                     std::string_view z, std::vector<Vec3>& path) {
+        static constexpr std::string_view kChildren[] = {"MotionBlurPosition"};
+        for (const XMLElement* c = e.FirstChildElement(); c; c = c->NextSiblingElement()) {
+            if (std::string_view(c->Name()) != kChildren[0]) {
+                context_.warn_unknown_element(*c, e, kChildren);
+                continue;
+            }
+            Attributes at(*c, context_);
+            path.push_back(at.vec3(x, y, z));
+            at.warn_unknown();
+            warn_children(*c);
+        }
+    }
+
+    void read_sphere(const XMLElement& e) {
+        Attributes in(e, context_);
+        std::vector<Vec3> path{in.vec3("Px", "Py", "Pz")};
+        const double radius = in.number("Radius");
+        if (radius < 0) in.fail("negative radius " + in.shown("Radius"));
+        in.check(radius > 0, "Radius", "positive");
+        std::string material = in.text("Material");
+        SurfaceSpec surface = read_surface(in);
+        in.warn_unknown();
+        warn_stray_text(e);
+
+        read_motion(e, "Px", "Py", "Pz", path);
+        pending_.push_back({&e, std::move(material), std::move(surface),
+                            [path = std::move(path), radius](const Material& m, SurfaceDetail d) {
+                                return std::make_unique<Sphere>(path, radius, m, std::move(d));
+                            }});
+    }
+
+    // Triangles and meshes (../shared/spec/scene-format.md, "Triangles and meshes").
+
+    void read_triangle(const XMLElement& e) {
+        Attributes in(e, context_);
+        ObjMesh obj;
+        obj.positions = {in.vec3("Ax", "Ay", "Az"), in.vec3("Bx", "By", "Bz"),
+                         in.vec3("Cx", "Cy", "Cz")};
+        obj.position_indices = {0, 1, 2};
+        obj.normal_indices.assign(3, ObjMesh::kNoNormal);
+        std::string material = in.text("Material");
+        SurfaceSpec surface = read_surface(in);
+        in.warn_unknown();
+        warn_children(e);
+        auto mesh = build_mesh(in, std::move(obj), {}, false);
+        if (mesh->dropped() > 0) context_.warn(e, "<Triangle> of zero area dropped");
+        pending_.push_back({&e, std::move(material), std::move(surface),
+                            [mesh = std::move(mesh)](const Material& m, SurfaceDetail d) {
+                                return std::make_unique<Mesh>(mesh, std::vector<Vec3>{Vec3{}}, m,
+                                                              std::move(d));
+                            }});
+    }
+
+    void read_mesh(const XMLElement& e) {
+        Attributes in(e, context_);
+        const std::string file = in.text("File");
+        std::string material = in.text("Material");
+        std::vector<Vec3> path{in.vec3("Tx", "Ty", "Tz", {})};
+        MeshTransform transform;
+        transform.scale = in.number("Scale", 1);
+        in.check(transform.scale > 0, "Scale", "positive");
+        transform.rotate_degrees = in.vec3("RotateX", "RotateY", "RotateZ", {});
+        const bool smooth = in.flag("Smooth", true);
+        SurfaceSpec surface = read_surface(in);
+        in.warn_unknown();
+        warn_stray_text(e);
+        read_motion(e, "Tx", "Ty", "Tz", path);
+
+        // Relative to the scene file's folder, as the scene's author sees it.
+        const std::filesystem::path obj_path =
+            std::filesystem::path(context_.file()).parent_path() / file;
+        ObjMesh obj;
+        try {
+            obj = read_obj(obj_path);
+            files_read_.push_back(obj_path);
+        } catch (const ObjOpenError& error) {
+            in.fail("cannot open " + obj_path.string() + ": " + error.what());
+        } catch (const ObjError& error) {
+            throw SceneError(error.what());
+        }
+        auto mesh = build_mesh(in, std::move(obj), transform, smooth);
+        if (const std::size_t n = mesh->dropped(); n > 0) {
+            context_.warn(e, std::to_string(n) + (n == 1 ? " triangle" : " triangles") +
+                                 " of zero area in " + obj_path.string() + " dropped");
+        }
+        pending_.push_back(
+            {&e, std::move(material), std::move(surface),
+             [mesh = std::move(mesh), path = std::move(path)](const Material& m, SurfaceDetail d) {
+                 return std::make_unique<Mesh>(mesh, path, m, std::move(d));
+             }});
+    }
+
+    static std::shared_ptr<const TriangleMesh> build_mesh(const Attributes& in, ObjMesh&& obj,
+                                                          const MeshTransform& transform,
+                                                          bool smooth) {
+        try {
+            return std::make_shared<const TriangleMesh>(std::move(obj), transform, smooth);
+        } catch (const std::domain_error& error) {
+            in.fail(error.what());
+        }
+    }
+
+    void resolve_objects() {
+        for (const PendingObject& p : pending_) {
+            const Material* material = scene_.find_material(p.material);
+            if (!material) context_.fail(*p.element, unknown_material(p.material));
+            scene_.objects.push_back(p.make(*material, p.surface.build(*material)));
+        }
+    }
+
+    std::string unknown_material(const std::string& name) const {
+        std::vector<std::string_view> names;
+        for (const auto& m : scene_.materials) names.push_back(m->name);
+        std::string message = "unknown material '" + abbreviated(name) + "'";
+        if (const auto guess = nearest(name, names))
+            message += "; did you mean '" + std::string(*guess) + "'?";
+        return message;
+    }
+
+    Context context_;
+    Scene scene_;
+    std::map<std::string, int, std::less<>> setting_lines_;
+    std::map<std::string, int, std::less<>> material_lines_;
+    std::vector<PendingObject> pending_;
+    std::vector<std::filesystem::path> files_read_;
+};
+
+std::string read_file(const std::filesystem::path& path) {
+    const auto cannot_open = [&](int error) {
+        return SceneError(printable(path.string()) + ": cannot open scene: " +
+                          std::error_code(error, std::generic_category()).message());
+    };
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
+                                                         &std::fclose);
+    if (!file) throw cannot_open(errno);
+    std::string contents;
+    char buffer[1 << 16];
+    std::size_t n = 0;
+    while ((n = std::fread(buffer, 1, sizeof buffer, file.get())) > 0) {
+        // Checked while reading, so that an endless input (/dev/zero) stops too.
+        if (contents.size() + n > kMaxSceneBytes) {
+            throw SceneError(printable(path.string()) + ": scene file larger than the " +
+                             std::to_string(kMaxSceneBytes >> 20) + " MiB limit");
+        }
+        contents.append(buffer, n);
+    }
+    // A directory opens fine on Linux and fails only when read (EISDIR).
+    if (std::ferror(file.get())) throw cannot_open(errno);
+    return contents;
+}
+
+}  // namespace
+
+LoadedScene load_scene(const std::filesystem::path& path) {
+    const std::string xml = read_file(path);
+    return SceneReader(path.string()).read(xml);
+}
+
+LoadedScene load_scene_from_string(std::string_view xml, const std::string& name) {
+    return SceneReader(name).read(xml);
+}
+
+}  // namespace drt

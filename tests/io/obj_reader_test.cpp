@@ -1,0 +1,159 @@
+#include "drt/io/obj_reader.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace drt {
+namespace {
+
+using Indices = std::vector<std::uint32_t>;
+constexpr std::uint32_t kNone = ObjMesh::kNoNormal;
+
+ObjMesh parse(std::string_view text) {
+    return parse_obj(text, "m.obj");
+}
+
+// The message a file fails with, or "parsed".
+std::string error_of(std::string_view text) {
+    try {
+        parse(text);
+    } catch (const ObjError& e) {
+        return e.what();
+    }
+    return "parsed";
+}
+
+constexpr std::string_view kSquare =
+    "v 0 0 0\n"
+    "v 1 0 0\n"
+    "v 1 1 0\n"
+    "v 0 1 0\n";
+
+TEST(ObjReader, ReadsPositionsAndNormals) {
+    const ObjMesh m = parse("# a comment\nv 1 -2.5 3e2\nv +4 5 6 1\nvn 0 0 1\nv .5 -0 7\n");
+    ASSERT_EQ(m.positions.size(), 3u);
+    EXPECT_EQ(m.positions[0], (Vec3{1, -2.5, 300}));
+    EXPECT_EQ(m.positions[1], (Vec3{4, 5, 6}));  // the optional weight is read and dropped
+    EXPECT_EQ(m.positions[2], (Vec3{0.5, 0, 7}));
+    ASSERT_EQ(m.normals.size(), 1u);
+    EXPECT_EQ(m.normals[0], (Vec3{0, 0, 1}));
+    EXPECT_EQ(m.triangle_count(), 0u);
+}
+
+TEST(ObjReader, SplitsAPolygonIntoAFan) {
+    const ObjMesh m = parse(std::string(kSquare) + "v 0.5 2 0\nf 1 2 3 5 4\n");
+    EXPECT_EQ(m.position_indices, (Indices{0, 1, 2, 0, 2, 4, 0, 4, 3}));
+    EXPECT_EQ(m.normal_indices, Indices(9, kNone));
+}
+
+TEST(ObjReader, ReadsEveryCornerForm) {
+    const ObjMesh m = parse(std::string(kSquare) +
+                            "vt 0 0\nvt 1 0\nvn 0 0 1\nvn 0 0 -1\n"
+                            "f 1/1 2/2 3/1\n"
+                            "f 1//2 3//1 4//2\n"
+                            "f 2/1/1 3/2/2 4/1/1\n"
+                            "f 1 2/2 3//2\n");
+    EXPECT_EQ(m.position_indices, (Indices{0, 1, 2, 0, 2, 3, 1, 2, 3, 0, 1, 2}));
+    EXPECT_EQ(m.normal_indices, (Indices{kNone, kNone, kNone, 1, 0, 1, 0, 1, 0, kNone, kNone, 1}));
+}
+
+TEST(ObjReader, NegativeIndicesCountBackFromTheLatest) {
+    const ObjMesh m = parse(
+        "v 0 0 0\nv 1 0 0\nvn 1 0 0\nv 0 1 0\nf -3 -2 -1//-1\nv 5 5 5\n"
+        "f -4 -1 2\n");
+    EXPECT_EQ(m.position_indices, (Indices{0, 1, 2, 0, 3, 1}));
+    EXPECT_EQ(m.normal_indices, (Indices{kNone, kNone, 0, kNone, kNone, kNone}));
+}
+
+TEST(ObjReader, IgnoresOtherStatementsAndLineEndings) {
+    const ObjMesh m = parse(
+        "mtllib x.mtl\r\no thing\r\ng group\r\ns 1\r\nusemtl red\r\nv 0 0 0\r\nv 1 0 0\r\n"
+        "v 0 1 0 # trailing comment\r\n\r\n   \r\nl 1 2\r\nf 1 2 3\r\nvp 0.5\r\n"
+        "\tf\t1 3 2");  // no newline at the end
+    EXPECT_EQ(m.position_indices, (Indices{0, 1, 2, 0, 2, 1}));
+}
+
+TEST(ObjReader, RejectsCoordinatesThatAreNotFiniteNumbers) {
+    EXPECT_EQ(error_of("v 0 0 0\nv 0 abc 0\n"), "m.obj:2: v: \"abc\" is not a number");
+    EXPECT_EQ(error_of("v 0 0.5x 0\n"), "m.obj:1: v: \"0.5x\" is not a number");
+    EXPECT_EQ(error_of("v 0 +-1 0\n"), "m.obj:1: v: \"+-1\" is not a number");
+    EXPECT_EQ(error_of("\n\nv 0 nan 0\n"), "m.obj:3: v: \"nan\" is not a finite number");
+    EXPECT_EQ(error_of("v -inf 0 0\n"), "m.obj:1: v: \"-inf\" is not a finite number");
+    EXPECT_EQ(error_of("v 1e999 0 0\n"), "m.obj:1: v: \"1e999\" is out of range");
+    EXPECT_EQ(error_of("vn 0 0 NaN\n"), "m.obj:1: vn: \"NaN\" is not a finite number");
+    EXPECT_EQ(error_of("v 0 0 0 red\n"), "m.obj:1: v: \"red\" is not a number");
+    EXPECT_EQ(error_of("v 0 1\n"), "m.obj:1: v: 3 coordinates needed, got 2");
+    // What the file holds is shown safely: control characters escaped, a long value cut.
+    EXPECT_EQ(error_of("v 0 \x1b[2J 0\n"), "m.obj:1: v: \"\\x1b[2J\" is not a number");
+    EXPECT_EQ(error_of("v 0 " + std::string(400, '7') + "x 0\n"),
+              "m.obj:1: v: \"77777777777777777777... (401 characters)\" is not a number");
+    EXPECT_EQ(error_of("vn 0 1 0 1\n"), "m.obj:1: vn: more than 3 coordinates: \"1\"");
+}
+
+TEST(ObjReader, RejectsIndicesOutOfRange) {
+    const std::string v(kSquare);
+    EXPECT_EQ(error_of(v + "f 0 1 2\n"), "m.obj:5: f: vertex index 0 in \"0\"; indices start at 1");
+    EXPECT_EQ(error_of(v + "f 1 2 5\n"),
+              "m.obj:5: f: vertex index 5 is out of range; 4 defined above");
+    EXPECT_EQ(error_of(v + "f 1 2 -5\n"),
+              "m.obj:5: f: vertex index -5 is out of range; 4 defined above");
+    EXPECT_EQ(error_of(v + "f 1 2 99999999999999999999\n"),
+              "m.obj:5: f: vertex index 99999999999999999999 is out of range; 4 defined above");
+    // A vertex defined after the face does not count.
+    EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\n"),
+              "m.obj:3: f: vertex index 3 is out of range; 2 defined above");
+    EXPECT_EQ(error_of(v + "vn 0 0 1\nf 1//1 2//2 3//1\n"),
+              "m.obj:6: f: normal index 2 is out of range; 1 defined above");
+    EXPECT_EQ(error_of(v + "vn 0 0 1\nf 1//1 2//0 3//1\n"),
+              "m.obj:6: f: normal index 0 in \"2//0\"; indices start at 1");
+    EXPECT_EQ(error_of(v + "vt 0 0\nf 1/1 2/2 3/1\n"),
+              "m.obj:6: f: texture index 2 is out of range; 1 defined above");
+}
+
+TEST(ObjReader, RejectsMalformedFaces) {
+    const std::string v(kSquare);
+    EXPECT_EQ(error_of(v + "f 1 2\n"), "m.obj:5: f: a face needs at least 3 vertices, got 2");
+    EXPECT_EQ(error_of(v + "f\n"), "m.obj:5: f: a face needs at least 3 vertices, got 0");
+    EXPECT_EQ(error_of(v + "f 1 2 3x\n"), "m.obj:5: f: \"3x\" is not a vertex reference");
+    EXPECT_EQ(error_of(v + "f 1 2 3/\n"), "m.obj:5: f: \"3/\" is not a vertex reference");
+    EXPECT_EQ(error_of(v + "f 1 2 /3\n"), "m.obj:5: f: \"/3\" is not a vertex reference");
+    EXPECT_EQ(error_of(v + "vn 0 0 1\nf 1 2 3//\n"),
+              "m.obj:6: f: \"3//\" is not a vertex reference");
+    EXPECT_EQ(error_of(v + "vn 0 0 1\nf 1 2 3//1/1\n"),
+              "m.obj:6: f: \"3//1/1\" is not a vertex reference");
+}
+
+TEST(ObjReader, NamesAFileThatCannotBeOpened) {
+    try {
+        read_obj("/nonexistent/x.obj");
+        FAIL() << "read a missing file";
+    } catch (const ObjOpenError& e) {
+        EXPECT_STREQ(e.what(), "No such file or directory");
+    }
+    EXPECT_THROW(read_obj("/"), ObjOpenError);  // a folder
+}
+
+TEST(ObjReader, FileSizePastTheLimitIsRefusedBeforeReading) {
+    const auto path = std::filesystem::temp_directory_path() /
+                      ("drt_obj_limit_" + std::to_string(::getpid()) + ".obj");
+    { std::ofstream(path) << "v 0 0 0\n"; }
+    std::filesystem::resize_file(path, (std::uint64_t{1} << 30) + 1);  // sparse: nothing is read
+    try {
+        read_obj(path);
+        ADD_FAILURE() << "read a file past the limit";
+    } catch (const ObjError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  path.string() + ": file larger than the 1024 MiB limit for a mesh");
+    }
+    std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace drt

@@ -1,0 +1,381 @@
+// Checkpoint files (checkpoint.h) and resumed renders (render_job.h): what is kept is exactly
+// what was rendered, damage and foreign checkpoints are refused, and a render stopped and
+// resumed at any point, any number of times, gives the bits and ray counts of one never stopped.
+#include "drt/job/checkpoint.h"
+
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "drt/job/render_job.h"
+#include "drt/scene/scene_loader.h"
+#include "drt/util/atomic_file.h"
+#include "run_drt.h"
+#include "temp_folder.h"
+
+namespace drt {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace test;
+
+const fs::path kSource = DRT_SOURCE_DIR;
+// Motion blur, depth of field, glossy reflection and soft shadows in one scene.
+const fs::path kEffects = kSource / "scenes/thesis/test5.xml";
+
+Scene small_scene(const fs::path& file = kEffects) {
+    LoadedScene loaded = load_scene(file);
+    loaded.scene.settings.width = 40;
+    loaded.scene.settings.height = 28;
+    loaded.scene.settings.samples = 4;
+    return std::move(loaded.scene);
+}
+
+using TempDir = TempFolderTest;
+
+TileBuffer some_tile(const Tile& tile, float base) {
+    TileBuffer t;
+    t.tile = tile;
+    t.pixels = Image(tile.width(), tile.height());
+    for (std::size_t i = 0; i < t.pixels.rgb.size(); ++i) t.pixels.rgb[i] = base + float(i) / 7;
+    t.pixel_samples.assign(static_cast<std::size_t>(tile.width()) * tile.height(), 5);
+    t.spread = Image(tile.width(), tile.height());
+    for (std::size_t i = 0; i < t.spread.rgb.size(); ++i) t.spread.rgb[i] = base * 1e-3f + float(i);
+    t.error_sums = {0.1 + base, 1e-300, 12, 3.5};
+    t.rays = {11, 22, 33, 44};
+    t.samples = 5 * t.pixel_samples.size();
+    t.converged = 3;
+    return t;
+}
+
+RenderIdentity identity_of(const std::vector<Tile>& grid) {
+    return {"9.9.9",    {{"scene.xml", 0x1234}, {"models/mesh.obj", 0x9abc}}, 0x5678, 40, 28,
+            grid.size()};
+}
+
+TEST(Checkpoint, TilesComeBackWithEveryBitAndCount) {
+    const std::vector<Tile> grid = tile_grid(40, 28);
+    const std::vector<TileBuffer> tiles{some_tile(grid[4], 0.25f), some_tile(grid[0], -1e-30f)};
+    const std::vector<unsigned char> bytes = encode_checkpoint(identity_of(grid), tiles);
+    const Checkpoint c = decode_checkpoint(bytes, grid, "c");
+    EXPECT_EQ(c.identity, identity_of(grid));
+    ASSERT_EQ(c.tiles.size(), 2u);
+    for (std::size_t i = 0; i < 2; ++i) {
+        EXPECT_EQ(c.tiles[i].tile, tiles[i].tile);
+        EXPECT_EQ(c.tiles[i].pixels.rgb, tiles[i].pixels.rgb);
+        EXPECT_EQ(c.tiles[i].pixel_samples, tiles[i].pixel_samples);
+        EXPECT_EQ(c.tiles[i].spread.rgb, tiles[i].spread.rgb);
+        EXPECT_EQ(c.tiles[i].error_sums, tiles[i].error_sums);
+        EXPECT_EQ(c.tiles[i].rays.total(), 110u);
+        EXPECT_EQ(c.tiles[i].rays.refraction, 44u);
+        EXPECT_EQ(c.tiles[i].samples, tiles[i].samples);
+        EXPECT_EQ(c.tiles[i].converged, 3u);
+    }
+}
+
+TEST(Checkpoint, EveryDamagedByteAndEveryTruncationIsRefused) {
+    const std::vector<Tile> grid = tile_grid(40, 28);
+    const std::vector<unsigned char> bytes =
+        encode_checkpoint(identity_of(grid), std::vector{some_tile(grid[1], 2.0f)});
+    for (std::size_t i = 0; i < bytes.size(); i += 7) {
+        std::vector<unsigned char> damaged = bytes;
+        damaged[i] ^= 0x10;
+        EXPECT_THROW(decode_checkpoint(damaged, grid, "c"), CheckpointError) << "byte " << i;
+        const std::vector<unsigned char> cut(bytes.begin(), bytes.begin() + i);
+        EXPECT_THROW(decode_checkpoint(cut, grid, "c"), CheckpointError) << "length " << i;
+    }
+    try {
+        std::vector<unsigned char> damaged = bytes;
+        damaged[bytes.size() / 2] ^= 1;
+        decode_checkpoint(damaged, grid, "ck.bin");
+        FAIL();
+    } catch (const CheckpointError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "ck.bin: damaged or truncated checkpoint (checksum does not match)");
+    }
+}
+
+TEST(Checkpoint, IdentityCoversTheSceneBytesAndEverySettingButNotHowTheWorkIsDone) {
+    const Scene scene = small_scene();
+    const std::vector<fs::path> files{kEffects};
+    const RenderIdentity base = identify_render(files, scene.settings, std::nullopt, 12);
+    EXPECT_EQ(base, identify_render(files, scene.settings, std::nullopt, 12));
+    EXPECT_EQ(base.version, DRT_VERSION);
+    const auto differs = [&](auto change) {
+        RenderSettings s = scene.settings;
+        std::optional<AdaptiveSampling> adaptive;
+        change(s, adaptive);
+        return identify_render(files, s, adaptive, 12).options != base.options;
+    };
+    EXPECT_TRUE(differs([](RenderSettings& s, auto&) { s.seed += 1; }));
+    EXPECT_TRUE(differs([](RenderSettings& s, auto&) { s.samples += 1; }));
+    EXPECT_TRUE(differs([](RenderSettings& s, auto&) { s.shadow_rays += 1; }));
+    EXPECT_TRUE(differs([](RenderSettings& s, auto&) { s.glossy_rays += 1; }));
+    EXPECT_TRUE(differs([](RenderSettings& s, auto&) { s.max_depth += 1; }));
+    EXPECT_TRUE(differs([](RenderSettings& s, auto&) { s.sampler = "sobol"; }));
+    EXPECT_TRUE(differs([](RenderSettings& s, auto&) { s.pixel_plane_unit *= 1 + 1e-15; }));
+    EXPECT_TRUE(differs([](auto&, auto& a) { a = AdaptiveSampling{0.01, 16}; }));
+    const fs::path other = kSource / "scenes/thesis/test6.xml";
+    EXPECT_NE(identify_render(std::vector{other}, scene.settings, std::nullopt, 12).files,
+              base.files);
+    // Every file the scene reads, on its own and by its bytes alone.
+    const RenderIdentity two =
+        identify_render(std::vector{kEffects, other}, scene.settings, std::nullopt, 12);
+    ASSERT_EQ(two.files.size(), 2u);
+    EXPECT_EQ(two.files[0], base.files[0]);
+    EXPECT_EQ(two.files[1].name, other.string());
+    EXPECT_NE(two.files[1].hash, two.files[0].hash);
+    const std::string bytes = read_bytes(other);
+    EXPECT_EQ(two.files[1].hash,
+              hash_bytes({reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()}));
+}
+
+TEST_F(TempDir, ACheckpointOfAnotherRenderIsRefusedSayingWhatDiffers) {
+    const std::vector<Tile> grid = tile_grid(40, 28);
+    const RenderIdentity id = identity_of(grid);
+    const fs::path file = dir_ / "c.ckpt";
+    EXPECT_FALSE(read_checkpoint(file, id, grid).has_value());  // none yet: start afresh
+    replace_file(file, encode_checkpoint(id, std::vector{some_tile(grid[2], 1.0f)}));
+    EXPECT_EQ(read_checkpoint(file, id, grid)->tiles.size(), 1u);
+    const auto message = [&](RenderIdentity other) {
+        try {
+            read_checkpoint(file, other, grid);
+        } catch (const CheckpointError& e) {
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
+    RenderIdentity other = id;
+    other.version = "9.9.10";
+    EXPECT_NE(message(other).find("made by drt 9.9.9, not drt 9.9.10"), std::string::npos);
+    other = id;
+    other.files[0].hash += 1;
+    EXPECT_NE(message(other).find("made by another scene file (its contents differ)"),
+              std::string::npos);
+    other = id;
+    other.files[1] = {"meshes/mesh.obj", other.files[1].hash + 1};
+    EXPECT_EQ(message(other), file.string() +
+                                  ": checkpoint of another render: made by another version of "
+                                  "meshes/mesh.obj (a file the scene reads: its contents differ); "
+                                  "not resumed and nothing written (delete it or name another "
+                                  "--checkpoint file)");
+    other = id;
+    other.files.pop_back();
+    EXPECT_NE(message(other).find("made by a scene reading another number of files (1, not 0)"),
+              std::string::npos);
+    // The same bytes reached by other names (from another folder): the same render.
+    other = id;
+    other.files[0].name = "../elsewhere/scene.xml";
+    other.files[1].name = "../elsewhere/models/mesh.obj";
+    EXPECT_EQ(message(other), "accepted");
+    other = id;
+    other.options += 1;
+    EXPECT_EQ(message(other),
+              file.string() +
+                  ": checkpoint of another render: made by other options (samples, seed, sampler "
+                  "or another setting differs); not resumed and nothing written (delete it or "
+                  "name another --checkpoint file)");
+}
+
+// A plain render's image and ray counts, for the resumed ones to match.
+RenderResult plain(const Scene& scene, const std::optional<AdaptiveSampling>& adaptive) {
+    RenderOptions options;
+    options.threads = 2;
+    options.adaptive = adaptive;
+    return render(scene, options);
+}
+
+TEST_F(TempDir, RendersStoppedAndResumedAtSeveralPointsGiveThePlainRendersBits) {
+    const Scene scene = small_scene();
+    for (const auto& adaptive : {std::optional<AdaptiveSampling>{},
+                                 std::optional<AdaptiveSampling>{AdaptiveSampling{0.05, 2}}}) {
+        const RenderResult reference = plain(scene, adaptive);
+        RenderJobOptions options;
+        options.threads = 1;  // stops after exactly the given count (two threads may overshoot)
+        options.adaptive = adaptive;
+        options.checkpoint = dir_ / "c.ckpt";
+        options.scene_files = {kEffects};
+        RenderJobResult r;
+        std::size_t resumed = 0;
+        for (const std::size_t stop : {1, 2, 5}) {  // of 6 tiles
+            options.stop_after_tiles = stop;
+            r = run_render_job(scene, options);
+            ASSERT_FALSE(r.complete());
+            EXPECT_EQ(r.resumed, resumed);
+            EXPECT_EQ(r.done, stop);
+            resumed = r.done;
+            ASSERT_TRUE(fs::exists(*options.checkpoint));
+        }
+        options.stop_after_tiles.reset();
+        options.threads = 2;
+        r = run_render_job(scene, options);
+        ASSERT_TRUE(r.complete());
+        EXPECT_EQ(r.resumed, resumed);
+        EXPECT_EQ(r.render.image.rgb, reference.image.rgb);
+        EXPECT_EQ(r.render.pixel_samples, reference.pixel_samples);
+        EXPECT_EQ(r.render.stats.rays.total(), reference.stats.rays.total());
+        EXPECT_EQ(r.render.stats.rays.shadow, reference.stats.rays.shadow);
+        EXPECT_EQ(r.render.stats.samples, reference.stats.samples);
+        EXPECT_EQ(r.render.stats.pixels_converged, reference.stats.pixels_converged);
+        fs::remove(*options.checkpoint);
+    }
+}
+
+// ---- the command line -------------------------------------------------------------------------
+
+class CheckpointCli : public TempDir {
+  protected:
+    std::vector<std::string> command(const std::string& output, std::vector<std::string> more = {},
+                                     const std::string& spp = "4",
+                                     const std::string& threads = "2") const {
+        std::vector<std::string> args{
+            kEffects.string(), "--width", "48", "--height", "32", "--spp", spp, "-o", output,
+            "--threads",       threads};
+        args.insert(args.end(), more.begin(), more.end());
+        return args;
+    }
+    Outcome run(const std::vector<std::string>& args) const { return run_drt(args, dir_); }
+};
+
+TEST_F(CheckpointCli, InterruptedRunsWritePartialAndCheckpointAndTheLastOneTheSameBits) {
+    ASSERT_EQ(run(command("plain.pfm", {"--stats", "plain.json"})).status, 0);
+    const std::vector<std::string> resumable =
+        command("out.pfm", {"--checkpoint", "c.ckpt", "--stats", "out.json"});
+    for (const std::string stop : {"1", "3"}) {
+        std::vector<std::string> args = resumable;
+        args.insert(args.end(), {"--stop-after-tiles", stop});
+        const Outcome r = run(args);
+        EXPECT_EQ(r.status, 130) << r.err;
+        EXPECT_NE(r.err.find("wrote out.partial.pfm and c.ckpt\ndrt: run the same command again "
+                             "to resume"),
+                  std::string::npos)
+            << r.err;
+        EXPECT_FALSE(fs::exists(dir_ / "out.pfm"));
+        EXPECT_TRUE(fs::exists(dir_ / "out.partial.pfm"));
+        EXPECT_TRUE(fs::exists(dir_ / "c.ckpt"));
+    }
+    const Outcome r = run(resumable);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("tiles resumed"), std::string::npos) << r.err;
+    EXPECT_EQ(read_bytes(dir_ / "out.pfm"), read_bytes(dir_ / "plain.pfm"));
+    EXPECT_FALSE(fs::exists(dir_ / "c.ckpt"));  // removed once the image is written
+    EXPECT_FALSE(fs::exists(dir_ / "out.partial.pfm"));
+    const auto rays = [&](const std::string& json) {
+        const std::string text = read_bytes(dir_ / json);
+        return text.substr(text.find("\"rays\""),
+                           text.find('}', text.find("\"rays\"")) - text.find("\"rays\""));
+    };
+    EXPECT_EQ(rays("out.json"), rays("plain.json"));
+}
+
+TEST_F(CheckpointCli, DamagedTruncatedAndForeignCheckpointsExitTwoAndChangeNothing) {
+    std::vector<std::string> args = command("out.pfm", {"--checkpoint", "c.ckpt"});
+    args.insert(args.end(), {"--stop-after-tiles", "2"});
+    ASSERT_EQ(run(args).status, 130);
+    const std::string good = read_bytes(dir_ / "c.ckpt");
+    std::string damaged = good;
+    damaged[damaged.size() / 2] ^= 0x40;
+    std::string format2 = good;  // written by a drt before each file had its own fingerprint
+    format2[7] = '2';
+    const std::vector<std::pair<std::string, std::string>> cases{
+        {format2,
+         "checkpoint format 2 of another drt version, this one reads format 4: not resumed and "
+         "nothing written (delete it or name another --checkpoint file)"},
+        {damaged, "checksum does not match"},
+        {good.substr(0, good.size() - 100), "checksum does not match"},
+        {good.substr(0, 5), "not a drt checkpoint"},
+        {"hello", "not a drt checkpoint"}};
+    for (const auto& [bytes, why] : cases) {
+        write_bytes(dir_ / "bad.ckpt", bytes);
+        const Outcome r = run(command("out.pfm", {"--checkpoint", "bad.ckpt"}));
+        EXPECT_EQ(r.status, 2) << why;
+        EXPECT_NE(r.err.find("bad.ckpt: "), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find(why), std::string::npos) << r.err;
+        EXPECT_EQ(read_bytes(dir_ / "bad.ckpt"), bytes);
+        EXPECT_FALSE(fs::exists(dir_ / "out.pfm"));
+    }
+    // The same checkpoint for another seed, and for another scene.
+    Outcome r = run(command("out.pfm", {"--checkpoint", "c.ckpt", "--seed", "7"}));
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("checkpoint of another render: made by other options"), std::string::npos)
+        << r.err;
+    std::vector<std::string> other = command("out.pfm", {"--checkpoint", "c.ckpt"});
+    other[0] = (kSource / "scenes/thesis/test6.xml").string();
+    r = run(other);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("made by another scene file"), std::string::npos) << r.err;
+    EXPECT_EQ(read_bytes(dir_ / "c.ckpt"), good);
+    EXPECT_FALSE(fs::exists(dir_ / "out.pfm"));
+}
+
+TEST_F(CheckpointCli, AnEditedMeshFileIsRefusedNamingItAndTheOriginalResumes) {
+    write_bytes(dir_ / "scene.xml",
+                "<Scene><Image Width=\"48\" Height=\"32\"/><Materials><Gray/></Materials>"
+                "<Mesh File=\"models/tri.obj\" Material=\"Gray\"/></Scene>");
+    fs::create_directories(dir_ / "models");
+    const std::string obj = "v -5 -5 20\nv 5 -5 20\nv 0 5 20\nf 1 2 3\n";
+    write_bytes(dir_ / "models/tri.obj", obj);
+    const std::vector<std::string> args{"scene.xml", "-o", "out.pfm", "--checkpoint", "c.ckpt"};
+    std::vector<std::string> stopped = args;
+    stopped.insert(stopped.end(), {"--stop-after-tiles", "1"});
+    ASSERT_EQ(run(stopped).status, 130);
+    const std::string kept = read_bytes(dir_ / "c.ckpt");
+    write_bytes(dir_ / "models/tri.obj", "v -5 -5 20\nv 5 -5 20\nv 0 6 20\nf 1 2 3\n");
+    Outcome r = run(args);
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.err, "drt: c.ckpt: checkpoint of another render: made by another version of " +
+                         (fs::path("models") / "tri.obj").string() +
+                         " (a file the scene reads: its contents differ); not resumed and "
+                         "nothing written (delete it or name another --checkpoint file)\n");
+    EXPECT_EQ(read_bytes(dir_ / "c.ckpt"), kept);
+    EXPECT_FALSE(fs::exists(dir_ / "out.pfm"));
+    write_bytes(dir_ / "models/tri.obj", obj);
+    r = run(args);
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("tiles resumed"), std::string::npos) << r.err;
+}
+
+// Waits until `file` is written anew (the render is under way), up to a minute.
+bool wait_for(const fs::path& file) {
+    const auto written = [&] {
+        std::error_code ec;
+        const auto t = fs::last_write_time(file, ec);
+        return ec ? fs::file_time_type::min() : t;
+    };
+    const auto before = written();
+    for (int i = 0; i < 6000 && written() == before; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return written() != before;
+}
+
+TEST_F(CheckpointCli, SigintAndSigtermStopSaveAndExit130And143ThenTheRerunFinishesTheSameBits) {
+    // Enough work that a signal arrives mid-render; a checkpoint after every tile shows when.
+    const std::vector<std::string> more{"--checkpoint", "c.ckpt", "--checkpoint-every", "0"};
+    ASSERT_EQ(run(command("plain.pfm", {}, "64", "1")).status, 0);
+    for (const int sig : {SIGINT, SIGTERM}) {
+        std::vector<std::string> argv{DRT_BINARY};
+        for (const std::string& a : command("out.pfm", more, "64", "1")) argv.push_back(a);
+        const pid_t pid = start_process(argv, dir_);
+        ASSERT_TRUE(wait_for(dir_ / "c.ckpt"));
+        kill(pid, sig);
+        const Outcome r = finish_process(pid, dir_);
+        if (r.status == 0) continue;  // finished before the signal: nothing to test this time
+        EXPECT_EQ(r.status, 128 + sig) << r.err;
+        EXPECT_NE(r.err.find("run the same command again to resume"), std::string::npos);
+        EXPECT_FALSE(fs::exists(dir_ / "out.pfm"));
+        EXPECT_TRUE(fs::exists(dir_ / "out.partial.pfm"));
+    }
+    const Outcome r = run(command("out.pfm", more, "64", "1"));
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(read_bytes(dir_ / "out.pfm"), read_bytes(dir_ / "plain.pfm"));
+    EXPECT_FALSE(fs::exists(dir_ / "c.ckpt"));
+}
+
+}  // namespace
+}  // namespace drt

@@ -1,0 +1,246 @@
+// The cost guess that orders the tiles: shaded rays a pilot traces, scaled to the tile, and the
+// order it gives (which changes no pixel: renderer_test.cpp renders tiles in any order); a
+// render without its error estimate.
+#include "drt/render/render_context.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "drt/scene/light.h"
+#include "test_scenes.h"
+
+namespace drt {
+namespace {
+
+// A mirror sphere filling the middle of a 96 × 96 image: a camera ray there traces one
+// reflection (which leaves the convex sphere for the background); the corner tiles see only
+// background, one camera ray a pixel.
+Scene mirror_ball() {
+    return testing::lone_sphere_scene(testing::mirror({0.5, 0.5, 0.5}), {0.1, 0.2, 0.3}, 96);
+}
+
+TEST(EstimateCost, CountsThePilotsShadedRaysScaledToTheTile) {
+    const Scene scene = mirror_ball();
+    const RenderContext context(scene, std::nullopt);
+    const std::vector<Tile>& tiles = context.tiles();
+    ASSERT_EQ(tiles.size(), 36u);
+    EXPECT_EQ(context.estimate_cost(tiles[0]), 256u);  // top left: background only
+    EXPECT_EQ(context.estimate_cost(tiles[35]), 256u);
+    EXPECT_EQ(context.estimate_cost(tiles[14]), 512u);  // beside the centre: all mirror
+    EXPECT_EQ(context.estimate_cost(tiles[21]), 512u);
+    // An edge tile of 8 × 16 pixels, background only: half the cost.
+    const Scene narrow =
+        testing::lone_sphere_scene(testing::mirror({0.5, 0.5, 0.5}), {0.1, 0.2, 0.3}, 88);
+    const RenderContext cut(narrow, std::nullopt);
+    EXPECT_EQ(cut.tiles()[5].width(), 8);
+    EXPECT_EQ(cut.estimate_cost(cut.tiles()[5]), 128u);
+}
+
+TEST(EstimateCost, LeavesShadowRaysOut) {
+    // A grey ball lit through 8 shadow rays a shading point: the tiles on the ball trace 9 rays a
+    // camera sample, those of the background 1, yet both count one shaded ray a pixel — a shading
+    // point's own work, not its shadow rays, is what a tile's time follows (design.md).
+    Scene scene = testing::lone_sphere_scene(testing::grey_lambert(), {0.1, 0.2, 0.3}, 96);
+    scene.settings.shadow_rays = 8;
+    scene.lights.push_back(
+        std::make_unique<SphereLight>(Vec3{0, 5, -10}, 1.0, Color{1, 1, 1}, false));
+    const RenderContext context(scene, std::nullopt);
+    const TileBuffer ball = context.render_tile(context.tiles()[14]);
+    ASSERT_EQ(ball.rays.shadow, 8u * ball.rays.camera);  // every pixel on the lit side
+    EXPECT_EQ(context.estimate_cost(context.tiles()[14]), 256u);
+    EXPECT_EQ(context.estimate_cost(context.tiles()[0]), 256u);
+}
+
+TEST(CostlyFirst, OrdersByFallingCostAndKeepsIndexOrderAmongEquals) {
+    const Scene scene = mirror_ball();
+    const RenderContext context(scene, std::nullopt);
+    const std::vector<Tile> order = costly_first(context, context.tiles(), 2);
+    ASSERT_EQ(order.size(), context.tiles().size());
+    EXPECT_TRUE(std::is_permutation(order.begin(), order.end(), context.tiles().begin()));
+    EXPECT_EQ(order.front().index, 7u);  // the first of the all-mirror tiles
+    EXPECT_EQ(order.back().index, 35u);  // the last of the background-only ones
+    for (std::size_t i = 1; i < order.size(); ++i) {
+        const auto before = context.estimate_cost(order[i - 1]);
+        const auto after = context.estimate_cost(order[i]);
+        EXPECT_GE(before, after) << i;
+        if (before == after) {
+            EXPECT_LT(order[i - 1].index, order[i].index) << i;
+        }
+    }
+}
+
+TEST(CostlyFirst, ThePilotsThreadsChangeNoPlace) {
+    const Scene scene = testing::scaled_scene("thesis/test4.xml", 80, 4);
+    const RenderContext context(scene, std::nullopt);
+    const std::vector<Tile> one = costly_first(context, context.tiles(), 2, 1);
+    ASSERT_NE(one, context.tiles());
+    EXPECT_EQ(costly_first(context, context.tiles(), 2, 3), one);
+    EXPECT_EQ(costly_first(context, context.tiles(), 2, 64), one);  // more threads than tiles
+}
+
+TEST(CostlyFirst, LeavesOneWorkersTilesAlone) {
+    const Scene scene = mirror_ball();
+    const RenderContext context(scene, std::nullopt);
+    EXPECT_EQ(costly_first(context, context.tiles(), 1), context.tiles());
+}
+
+TEST(RenderContext, WithoutTheEstimateRendersTheSamePixelsAndNoneTwice) {
+    Scene scene = mirror_ball();
+    scene.settings.samples = 4;  // the stratified sampler: calibrated by second renders
+    const RenderContext with(scene, std::nullopt);
+    const RenderContext without(scene, std::nullopt, false);
+    ErrorSums calibrated;
+    for (const Tile& tile : with.tiles()) {
+        const TileBuffer a = with.render_tile(tile);
+        const TileBuffer b = without.render_tile(tile);
+        EXPECT_EQ(a.pixels.rgb, b.pixels.rgb) << tile.index;
+        EXPECT_EQ(a.rays.total(), b.rays.total()) << tile.index;
+        EXPECT_EQ(b.error_sums, ErrorSums{}) << tile.index;
+        calibrated += a.error_sums;
+    }
+    EXPECT_GE(calibrated.pixels, 64);  // 8 % of 9,216 pixels rendered twice on average
+}
+
+TEST(RenderContext, APixelBlockRendersOnePixelOfEachSquareAsTheFullRenderDoes) {
+    // 90 x 90 in squares of 4: 22 x 22 whole squares and a row and a column of squares that the
+    // image's edge cuts to 2 pixels across.
+    Scene scene = testing::scaled_scene("thesis/test1.xml", 90, 4);
+    scene.settings.height = 90;
+    const RenderContext full(scene, std::nullopt);
+    const RenderContext pilot(scene, std::nullopt, true, 4);
+    std::uint64_t picked = 0, in_cut_squares = 0;
+    for (int sy = 0; sy < 90; sy += 4) {
+        for (int sx = 0; sx < 90; sx += 4) {
+            int in_square = 0;
+            for (int y = sy; y < std::min(sy + 4, 90); ++y) {
+                for (int x = sx; x < std::min(sx + 4, 90); ++x) in_square += pilot.renders(x, y);
+            }
+            // One in a whole square; at most one in a cut square, whose place may lie outside
+            // the image, so that every pixel has the same odds.
+            if (sx + 4 <= 90 && sy + 4 <= 90) {
+                EXPECT_EQ(in_square, 1) << sx << " " << sy;
+            } else {
+                EXPECT_LE(in_square, 1) << sx << " " << sy;
+                in_cut_squares += static_cast<std::uint64_t>(in_square);
+            }
+            picked += static_cast<std::uint64_t>(in_square);
+        }
+    }
+    EXPECT_EQ(pilot.rendered_pixels(), picked);
+    EXPECT_EQ(full.rendered_pixels(), 8100u);
+    // 45 cut squares hold 8 (or 4) of their 16 places inside: about 22 picked; 1 in 16 each
+    // would make at least 3 and at most 43 all but impossible.
+    EXPECT_GE(in_cut_squares, 3u);
+    EXPECT_LE(in_cut_squares, 43u);
+    // Another seed picks other places: the same as this one's in about 1 square in 16.
+    Scene reseeded = testing::scaled_scene("thesis/test1.xml", 90, 4);
+    reseeded.settings.height = 90;
+    reseeded.settings.seed = scene.settings.seed + 1;
+    const RenderContext other(reseeded, std::nullopt, true, 4);
+    int same = 0;
+    for (int y = 0; y < 88; ++y) {
+        for (int x = 0; x < 88; ++x) same += pilot.renders(x, y) && other.renders(x, y);
+    }
+    EXPECT_LT(same, 484 / 4);
+    // A picked pixel has the full render's bits and takes the tile's only samples; the others
+    // are 0 with no spread.
+    std::uint64_t samples = 0;
+    for (const Tile& tile : full.tiles()) {
+        const TileBuffer a = full.render_tile(tile);
+        const TileBuffer b = pilot.render_tile(tile);
+        samples += b.samples;
+        for (int y = tile.y0; y < tile.y1; ++y) {
+            for (int x = tile.x0; x < tile.x1; ++x) {
+                const int tx = x - tile.x0, ty = y - tile.y0;
+                const bool rendered = pilot.renders(x, y);
+                EXPECT_EQ(b.pixels.at(tx, ty), rendered ? a.pixels.at(tx, ty) : Color{})
+                    << x << " " << y;
+                EXPECT_EQ(b.spread.at(tx, ty), rendered ? a.spread.at(tx, ty) : Color{})
+                    << x << " " << y;
+            }
+        }
+    }
+    EXPECT_EQ(samples, 4 * picked);
+}
+
+TEST(RenderContext, APilotTileRendersThePickedPixelsOfSquaresThatCrossItsEdges) {
+    // Squares of 5 and 7 do not divide the tiles of 16: a tile holds parts of squares whose
+    // picked pixel may lie in it or in a neighbour.
+    Scene scene = testing::scaled_scene("thesis/test1.xml", 90, 2);
+    scene.settings.height = 61;
+    for (const int block : {5, 7}) {
+        const RenderContext pilot(scene, std::nullopt, true, block);
+        std::uint64_t rendered = 0;
+        for (const Tile& tile : pilot.tiles()) {
+            const TileBuffer buffer = pilot.render_tile(tile);
+            for (int y = tile.y0; y < tile.y1; ++y) {
+                for (int x = tile.x0; x < tile.x1; ++x) {
+                    const std::uint32_t samples =
+                        buffer.pixel_samples[std::size_t(y - tile.y0) * std::size_t(tile.width()) +
+                                             std::size_t(x - tile.x0)];
+                    EXPECT_EQ(samples, pilot.renders(x, y) ? 2u : 0u)
+                        << block << ": " << x << " " << y;
+                    rendered += samples / 2;
+                }
+            }
+        }
+        EXPECT_EQ(rendered, pilot.rendered_pixels()) << block;
+    }
+}
+
+TEST(RenderContext, ATopUpRendersItsPixelsTwiceAndAveragesThem) {
+    Scene scene = testing::scaled_scene("thesis/test1.xml", 40, 4);
+    scene.settings.height = 30;
+    // Pixels in three tiles, a corner and an edge among them.
+    const std::vector<std::uint32_t> top_up{0, 17, 39, 40 * 16 + 20, 40 * 29 + 39};
+    const RenderContext full(scene, std::nullopt);
+    const RenderContext again(scene, std::nullopt, true, 1, top_up);
+    EXPECT_EQ(again.rendered_pixels(), top_up.size());
+    std::uint64_t samples = 0;
+    double pairs = 0;
+    for (const Tile& tile : full.tiles()) {
+        const TileBuffer a = full.render_tile(tile);
+        const TileBuffer b = again.render_tile(tile);
+        samples += b.samples;
+        pairs += b.error_sums.pixels;
+        for (int y = tile.y0; y < tile.y1; ++y) {
+            for (int x = tile.x0; x < tile.x1; ++x) {
+                const int tx = x - tile.x0, ty = y - tile.y0;
+                const auto i = static_cast<std::uint32_t>(y * 40 + x);
+                const bool listed = std::find(top_up.begin(), top_up.end(), i) != top_up.end();
+                EXPECT_EQ(again.renders(x, y), listed) << x << " " << y;
+                if (!listed) {
+                    EXPECT_EQ(b.pixels.at(tx, ty), Color{}) << x << " " << y;
+                    continue;
+                }
+                // The mean of the plain render's pixel and an independent second render of it,
+                // and a quarter of their squared difference.
+                const Color second = 2.0 * b.pixels.at(tx, ty) - a.pixels.at(tx, ty);
+                EXPECT_NE(second, a.pixels.at(tx, ty)) << x << " " << y;
+                const Color d = a.pixels.at(tx, ty) - second;
+                const Color quarter = d * d * 0.25;
+                const Color spread = b.spread.at(tx, ty);
+                EXPECT_NEAR(spread.r, quarter.r, 1e-6 * (1 + quarter.r)) << x << " " << y;
+                EXPECT_NEAR(spread.g, quarter.g, 1e-6 * (1 + quarter.g)) << x << " " << y;
+                EXPECT_NEAR(spread.b, quarter.b, 1e-6 * (1 + quarter.b)) << x << " " << y;
+                EXPECT_EQ(
+                    b.pixel_samples[std::size_t(ty) * std::size_t(tile.width()) + std::size_t(tx)],
+                    8u);
+            }
+        }
+    }
+    EXPECT_EQ(samples, 8 * top_up.size());
+    // The spreads are the variance of the pairs' means: nothing to calibrate.
+    EXPECT_EQ(again.spread_kind(), SpreadKind::kIndependent);
+    EXPECT_EQ(pairs, 0.0);
+    EXPECT_THROW(RenderContext(scene, std::nullopt, true, 1, std::vector<std::uint32_t>{3, 3}),
+                 std::invalid_argument);
+    EXPECT_THROW(RenderContext(scene, std::nullopt, true, 1, std::vector<std::uint32_t>{1200}),
+                 std::invalid_argument);
+    EXPECT_THROW(RenderContext(scene, std::nullopt, true, 4, top_up), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace drt
