@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# drt's mesh hierarchy against Embree 3 (docs/performance.md, "Meshes"): on the Stanford bunny
+# drt's mesh hierarchy against Embree 3 (docs/performance.md, "Meshes against Embree"): on the Stanford bunny
 # (69k triangles) and on the bunny subdivided twice (1.1 M triangles, written to a temporary
 # folder, not kept), the same camera and shadow rays of scenes/meshes/glass-bunny.xml traced by
 # both on 2 threads, alternating round after round; then the peak memory of a render of the
