@@ -48,7 +48,7 @@ void BM_BvhBuild(benchmark::State& state) {
     }
 }
 
-// Shadow rays in Test1's room (five planes, two spheres) from points on the floor to a light of
+// Shadow rays in a room of five planes and two spheres from points on the floor to a light of
 // radius 40: tested against everything, or against the occluders gathered once per point for
 // its nine rays (the gathering included).
 void BM_RoomShadowRays(benchmark::State& state) {

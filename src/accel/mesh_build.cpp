@@ -44,8 +44,8 @@ struct Box {
     void grow(const Box& b) { grow(b.lo, b.hi); }
     float lo_at(int axis) const { return lane(lo, axis); }
     float hi_at(int axis) const { return lane(hi, axis); }
-    // In double, as 2 (xy + yz + zx) of the extents: the costs compared are those of the first
-    // build, bit for bit, and so is the tree. An empty box has none.
+    // In double, as 2 (xy + yz + zx) of the extents. The tree depends on these costs bit for
+    // bit, so a change to this arithmetic changes the images. An empty box has none.
     double surface_area() const {
         if (lo_at(0) > hi_at(0)) return 0;
         double e[3];
@@ -128,11 +128,9 @@ class Builder {
         }
         std::uint32_t second_index = 0;
         if (tasks > 1 && count >= kParallelBuild) {
-            // The first subtree on this thread and the second on a new one, into nodes of its
-            // own, then appended after the first: where the sequential build would have put it,
-            // node for node. (fork_join hands an exception on either thread, say
-            // std::bad_alloc, back to the caller, where one leaving a thread of its own would end
-            // the program.)
+            // The first subtree on this thread, the second on a new one into nodes of its own,
+            // then appended after the first: node for node where the sequential build puts it.
+            // fork_join brings an exception on either thread (std::bad_alloc) back to the caller.
             std::vector<BinaryNode> second_nodes;
             fork_join(
                 [&] {
@@ -166,13 +164,11 @@ class Builder {
         Extent first, second;
     };
 
-    // Binned surface-area heuristic (Wald 2007) along each axis whose centres spread: the cost
-    // of a split ∝ area × triangles on each side, against a leaf's cost ∝ its triangles; the
-    // cheapest split of the three axes. Binning all three in one pass over the items costs
-    // little more than one (the items are read once), and the tree is better than one binned
-    // along the longest axis alone: fewer boxes and triangles a ray meets. Partitions the items
-    // at the best split and returns it with the halves' extents, or nothing if a leaf is
-    // cheaper.
+    // Binned surface-area heuristic (Wald 2007) on every axis whose centres spread, in one pass:
+    // a split costs area × triangles on each side, a leaf its triangles. Three axes cost little
+    // more than one and make a tree in which rays meet fewer boxes and triangles. Partitions the
+    // items at the cheapest split and returns it with the halves' extents, or nothing if a leaf
+    // is cheaper.
     std::optional<Split> split_by_area(std::uint32_t begin, std::uint32_t end,
                                        const float (&centre_lo)[3], const float (&centre_extent)[3],
                                        double area) const {

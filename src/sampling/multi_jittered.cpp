@@ -91,8 +91,8 @@ constexpr std::uint32_t hash32(std::uint32_t x) {
 
 // The grid of k points: m = floor(sqrt(k)) columns by n rows, m*n >= k, and the reciprocals the
 // points are scaled by. Tabulated for the counts that sets and pixels use, because the square
-// root and three divisions cost as much as a small set's points (docs/performance.md, fifth
-// round); a constant expression rounds each reciprocal exactly as the run-time division does.
+// root and three divisions cost as much as a small set's points; a constant expression rounds
+// each reciprocal exactly as the run-time division does.
 struct Shape {
     std::uint32_t m = 1, n = 0;
     double inv_cells = 0, inv_k = 0;
@@ -118,12 +118,10 @@ Shape shape_for(std::uint32_t k) {
     return shape_of(k, std::max(1u, static_cast<std::uint32_t>(std::sqrt(double(k)))));  // floor
 }
 
-// The grids whose sides both have at most kListedOrders elements, k <= 25, keep each side's
-// order as the listed word of hexadecimal digits. Where stratum s = row * m + col of such a grid
-// finds its column's and its row's digit: the shifts 4 col (the low byte) and 4 row (the next),
-// for s < k and again at s + k, so that a rotated run of strata reads them in order, in a loop
-// that vectorises (the cells of a small set tabulated one by one cost as much as its points:
-// docs/performance.md, ninth round). 32-bit entries: narrower ones keep the loop from vectorising.
+// Grids whose sides both have at most kListedOrders elements (k <= 25) keep each side's order as
+// a word of hexadecimal digits. Stratum s = row * m + col finds its column's and row's digit at
+// the shifts 4 col (low byte) and 4 row (next byte), listed for s < k and again at s + k so that
+// a rotated run reads them in order, in a loop that vectorises (32-bit entries: narrower don't).
 constexpr std::uint32_t kPackedUpTo = kListedOrders * kListedOrders;
 using Places = std::array<std::uint32_t, 2 * kPackedUpTo>;
 constexpr std::array<Places, kPackedUpTo + 1> kPlaces = [] {
@@ -149,13 +147,10 @@ struct PackedSides {
 };
 
 // The grid of a pattern of k points keyed by `key`, its shuffled columns and sub-columns, the
-// jitters' key and a set's rotation: what every point of the pattern shares.
-//
-// The shuffles are dealt by Fisher-Yates from the digits of as few hashes as they need (one for
-// k up to 20), or picked from the list of all orders when a side has at most five elements;
-// beyond kDealtUpTo points, where a side's deal would need many hashes, they are Kensler's
-// permutation, evaluated per element. (Both are uniformly random orders; dealing is the cheaper
-// for the small sets that every shading point draws.)
+// jitters' key and a set's rotation: what every point of the pattern shares. A side of at most
+// five elements picks from the list of all orders; others are dealt by Fisher-Yates from as few
+// hashes as they need, or past kDealtUpTo points are Kensler's permutation per element. All are
+// uniformly random orders; dealing is cheapest for the small sets every shading point draws.
 class Grid {
     static constexpr std::uint32_t kDealtUpTo = 1024;
     static constexpr std::uint32_t kSmallSide = 64;  // the sides of k up to 4032 points
@@ -301,7 +296,7 @@ DRT_VECTORISED void packed_rotated_points(const Jitter& jitter, const PackedSide
 // permute(first + i, n, key) into out[i]. Every label takes a step, and then those still outside
 // [0, n) another, pass after pass over all of them (the others left as they are) until none is:
 // the same walks as permute's, in loops that vectorise, where a walk per label would mispredict
-// its end about once per label (docs/performance.md, fifth round).
+// its end about once per label.
 DRT_VECTORISED void permute_run(std::uint32_t first, std::uint32_t n, std::uint32_t key,
                                 std::uint32_t* out, std::size_t count) {
     if (n <= 1) {
@@ -355,8 +350,8 @@ void multi_jittered_set(std::uint32_t first, std::uint32_t k, std::uint32_t key,
                         std::span<Vec2> out) {
     const Grid grid(k, key);
     const Jitter jitter(grid);
-    // At most k points at a time, so that the strata wrap around at most once. (Sets are drawn
-    // at every shading point: the remainders are taken only when they can differ from a compare.)
+    // At most k points at a time, so that the strata wrap around at most once. `at % k` only
+    // where at >= k: sets are drawn at every shading point, and a compare is cheaper.
     const auto passes = [&](const auto& points) {
         for (std::size_t done = 0; done < out.size(); done += k) {
             const std::uint32_t at = first + static_cast<std::uint32_t>(done);

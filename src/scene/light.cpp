@@ -55,7 +55,7 @@ struct Cone {
 
 // Cone::sample for every point. Vectorised, it does the same IEEE operations (no fused
 // multiply-adds) several lanes at a time, so its results are bit-identical to the scalar
-// sample's (tests/light_test.cpp checks) and images do not depend on the machine.
+// sample's (tests/scene/light_test.cpp checks) and images do not depend on the machine.
 DRT_VECTORISED void sample_cone_batch(const Cone& cone, const Vec2* u, LightSample* out,
                                       std::size_t count) {
     for (std::size_t i = 0; i < count; ++i) out[i] = cone.sample(u[i]);

@@ -380,7 +380,7 @@ TEST(SamplerSobol, LowerDiscrepancyThanRandomAndStratified) {
 // The RMS error over many pixels of estimating the integral of a smooth function on the square,
 // f = exp(x) * cos(y) with integral (e - 1) * sin(1), falls as N^-1/2 for random points and
 // much faster for jittered strata and faster still for scrambled nets (N^-3/2 in theory for
-// smooth integrands; measured -0.5, -0.8 and -1.45).
+// smooth integrands).
 TEST(SamplerSobol, IntegrationErrorOfASmoothFunctionFallsFasterThanRandom) {
     const double exact = (std::exp(1.0) - 1) * std::sin(1.0);
     const std::vector<double> counts = {16, 64, 256, 1024};

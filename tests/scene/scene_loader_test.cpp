@@ -884,7 +884,7 @@ TEST(SceneLoaderLimits, CountsAtAndPastTheirLimits) {
               "t.xml:2: Render: GlossyRays must be at most 65536, got 65537");
     EXPECT_EQ(body_error(R"(<Render MaxDepth="513"/>)"),
               "t.xml:2: Render: MaxDepth must be at most 512, got 513");
-    // Past an int, as before: out of range, not wrapped.
+    // Past an int: out of range, not wrapped.
     EXPECT_EQ(body_error(R"(<Render Samples="2147483648"/>)"),
               "t.xml:2: Render: attribute 'Samples' is out of range: \"2147483648\"");
 }

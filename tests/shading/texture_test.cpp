@@ -296,7 +296,7 @@ TEST(TextureFactory, MakesKnownTexturesAndRejectsUnknownNames) {
 namespace drt {
 namespace {
 
-// A tiny scale puts points in cells past 2^63, where an integer cell index used to overflow
+// A tiny scale puts points in cells past 2^63, where a plain integer cell index would overflow
 // (undefined behaviour the sanitizer build reports). Cells that far are whole multiples of 2^10,
 // so even: the checker shows its first colour.
 TEST(TextureRobustness, TinyScalesAndHugeCoordinatesStayDefined) {

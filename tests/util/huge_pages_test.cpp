@@ -36,7 +36,7 @@ std::string huge_page_mode() {
     return mode;
 }
 
-// What the build relies on for its speed: an array asked for in huge pages gets them. Where
+// What a mesh's build relies on for its speed: an array asked for in huge pages gets them. Where
 // the kernel does not offer them at all, the hint is a no-op and there is nothing to check.
 TEST(HugePages, AnArrayAskedForHugePagesGetsThemWhereTheSystemOffersThem) {
 #ifdef __SANITIZE_ADDRESS__

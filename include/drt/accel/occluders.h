@@ -19,10 +19,9 @@ class Occluders {
     // (a room has six), a word is set and walked without branches, and planes past the 64th
     // are simply always tested (correct, only slower).
     static constexpr std::size_t kPlaneBits = 64;
-    // Primitives listed at most; more, and the rays traverse the tree instead. Measured with
-    // 4, 16 and 64 on scenes of 100 and 1000 spheres: 4 is 6 % slower at 1000, 64 no faster
-    // than 16 (docs/performance.md, sixth round). A fixed array keeps the culling on the stack
-    // (no allocation per shading point).
+    // Primitives listed at most; more, and the rays traverse the tree instead. Fewer would send
+    // scenes of many primitives to the tree too often, more lengthen the list without saving
+    // traversals. A fixed array keeps the culling on the stack (no allocation per shading point).
     static constexpr int kMaxListed = 16;
 
     // What a ray to the light must be tested against.
@@ -55,9 +54,8 @@ class Occluders {
 };
 
 // Whether a shading point's `rays` shadow rays to one light are worth culling before they are
-// traced, rather than each traversing the tree. The one place that decides: a scene of many
-// primitives (a mesh of 10^5 triangles, whose cone would list far more than kMaxListed) is to
-// skip the culling here, at a size found by measurement.
+// traced, rather than each traversing the tree: from two rays on, whatever the scene. The one
+// place that decides; it takes `bvh` so that a rule by scene size has somewhere to go.
 bool worth_culling(int rays, const Bvh& bvh);
 
 }  // namespace drt

@@ -39,13 +39,10 @@ struct SurfaceHit {
     Vec3 normal;          // geometric, unit, pointing out of the object
     Vec3 shading_normal;  // normal after bump mapping, same side as `normal`
     Color kd;             // diffuse colour after texturing
-    // Where shadow rays leave, and the normal that says which lights are above the surface:
-    // `point` and `normal`, except on a smooth mesh. There the lights a shading normal sees may
-    // be below the flat facet, and shadow rays from the facet would meet the facet's neighbours:
-    // black facets along the shadow terminator. Shadow rays leave instead from the point lifted
-    // onto the curved surface the vertex normals describe (Hanika, "Hacking the shadow
-    // terminator", Ray Tracing Gems II, 2021), and the interpolated normal decides which lights
-    // are above.
+    // Where shadow rays leave, and the normal that says which lights are above: `point` and
+    // `normal`, except on a smooth mesh, where rays from the flat facet would black out facets
+    // along the shadow terminator. There they leave from the point lifted onto the curved surface
+    // the vertex normals describe (Hanika, Ray Tracing Gems II, 2021), and that normal decides.
     Vec3 light_point, light_normal;
 };
 
@@ -109,12 +106,10 @@ class Object {
     struct SurfaceCoordinates {
         Vec3 texture_point, bump_point;
     };
-    // Where on the surface a hit lies, before texture and bump, written into `surface`: the
-    // exact point on the surface nearest to ray.at(t) (which removes most of the rounding error
-    // a hit point picks up), the geometric normal (unit, outward), the shading normal before
-    // bump mapping (the geometric one, or one a mesh interpolates over a triangle), and where
-    // shadow rays leave. Written in place rather than returned: copying a returned record cost
-    // 2 % of a render in stalled loads (docs/performance.md, fifth round).
+    // Where on the surface a hit lies, before texture and bump, written into `surface`: the point
+    // on the surface nearest ray.at(t) (rid of most of a hit point's rounding error), the
+    // geometric normal (unit, outward), the shading normal before bump mapping (a mesh's is
+    // interpolated) and where shadow rays leave. In place, so the record is not copied per hit.
     virtual SurfaceCoordinates locate(const Ray& ray, const Hit& hit,
                                       SurfaceHit& surface) const = 0;
 

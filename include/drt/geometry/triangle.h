@@ -1,14 +1,10 @@
-// Watertight ray–triangle intersection (Woop, Benthin & Wald, "Watertight Ray/Triangle
-// Intersection", JCGT 2013), the method pbrt-v4 uses.
-//
-// The ray is moved to the origin and sheared so that it runs along +z; each triangle is then
-// tested in 2-D by the signs of its three edge functions. A shared edge of two triangles is
-// evaluated from the same two sheared vertices in the opposite order, which gives exactly the
-// negated value (the two products commute and a - b rounds to -(b - a)), so a ray can neither
-// slip between two triangles nor hit only one of two that face it alike. A ray exactly on an
-// edge (an edge function of 0) hits both, at the same point: the nearest-hit search counts it
-// once. Woop et al. recompute zero edge functions in double from single precision; drt already
-// computes in double and accepts zeros instead, which keeps the test conservative.
+// Watertight ray–triangle intersection (Woop, Benthin & Wald, JCGT 2013, as in pbrt-v4): the ray
+// is moved to the origin and sheared to run along +z, and each triangle is tested in 2-D by the
+// signs of its three edge functions. Two triangles evaluate a shared edge from the same sheared
+// vertices in opposite order, which gives exactly the negated value (a - b rounds to -(b - a)),
+// so a ray can neither slip between them nor hit only one of two that face it alike; a ray
+// exactly on the edge hits both at the same point. Woop et al. recompute zero edge functions in
+// double; drt computes in double throughout and accepts zeros, which keeps the test conservative.
 #pragma once
 
 #include <cmath>

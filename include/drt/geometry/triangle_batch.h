@@ -8,7 +8,7 @@
 // edge functions of certainly opposite signs, or a t certainly outside the range. Everything
 // else (a ray within rounding of an edge or a vertex, of the range's ends, or a float overflow,
 // whose NaN fails every comparison that would rule a triangle out) goes on to the double test,
-// which decides as before. So the hits, their t and their barycentrics are bit for bit those of
+// which decides. So the hits, their t and their barycentrics are bit for bit those of
 // testing every triangle in double, and the mesh stays watertight. The same bounds read the
 // other way prove a hit (edge functions certainly of one sign, t certainly inside the range and
 // past the double test's own error bound for t): an any-hit query can answer from that alone.

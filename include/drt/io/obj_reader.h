@@ -1,7 +1,7 @@
-// Reads the subset of Wavefront OBJ that ../shared/spec/scene-format.md ("Triangles and meshes")
-// defines: `v`, `vn` and `f` (polygons split into fans), indices in the forms v, v/vt, v//vn and
-// v/vt/vn, positive or negative (relative). Every other statement is ignored. A malformed
-// number or index is an error naming the file and line, never a silent zero.
+// Reads the subset of Wavefront OBJ that docs/scene-format.md ("Meshes") defines: `v`, `vn` and `f`
+// (polygons split into fans), indices in the forms v, v/vt, v//vn and v/vt/vn, positive or negative
+// (relative). Every other statement is ignored. A malformed number or index is an error naming the
+// file and line, never a silent zero.
 #pragma once
 
 #include <cstdint>

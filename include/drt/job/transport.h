@@ -27,7 +27,7 @@ class Sending {
 };
 
 // Messages of bytes between the processes of one job, and the two collectives drt needs.
-// Implemented over MPI by the module (src/mpi_module/); at most one thread calls it at a time.
+// Implemented over MPI by the module (src/job/mpi_module/); at most one thread calls it at a time.
 class Transport {
   public:
     static constexpr int kAny = -1;

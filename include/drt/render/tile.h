@@ -86,9 +86,9 @@ class TileQueue final : public TileSource {
     std::optional<std::chrono::steady_clock::time_point> emptied_;  // by the last tile's taker
 };
 
-// Assembles tile buffers into the image, the per-pixel sample counts and spreads and the
-// totals, and
-// remembers which tiles it has. A tile given twice is an error: its counts would be summed twice.
+// Assembles tile buffers into the image, the per-pixel sample counts and spreads and the totals,
+// and remembers which tiles it has. A tile given twice is an error: its counts would be summed
+// twice.
 class ImageSink final : public TileSink {
   public:
     ImageSink(int width, int height, std::vector<Tile> grid);

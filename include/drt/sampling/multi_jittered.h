@@ -30,7 +30,7 @@ void multi_jittered(std::uint32_t first, std::uint32_t k, std::uint32_t key, std
 // labelled by a keyed rotation of the strata, j -> (j + r) mod k, instead of a permutation. A set
 // (the shadow rays of one shading point, the glossy rays of one hit) is used whole, so how its
 // points are labelled does not matter as long as each is uniform over the square, which the
-// rotation keeps; it is cheaper than a permutation (docs/performance.md).
+// rotation keeps, and a rotation is cheaper than a permutation.
 void multi_jittered_set(std::uint32_t first, std::uint32_t k, std::uint32_t key,
                         std::span<Vec2> out);
 

@@ -1,4 +1,4 @@
-// Reads the thesis's XML scene format (../shared/spec/scene-format.md) into a Scene.
+// Reads the thesis's XML scene format (docs/scene-format.md) into a Scene.
 #pragma once
 
 #include <filesystem>

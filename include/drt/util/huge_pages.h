@@ -1,8 +1,7 @@
-// Large arrays that are allocated and then filled at once (a mesh's triangles, its hierarchy and
-// the build's working arrays: tens of MiB for a million triangles) cost a page fault for every
-// 4 KiB page they touch, some 8 µs each on a virtual machine: a third of a mesh's build time.
-// Asked for, Linux backs them with 2 MiB pages instead (transparent huge pages in "madvise"
-// mode, the usual default), 512 times fewer faults.
+// Large arrays allocated and then filled at once (a mesh's triangles, its hierarchy, the build's
+// working arrays) cost a page fault for every 4 KiB page they touch, a large share of a mesh's
+// build. Asked for, Linux backs them with 2 MiB pages instead (transparent huge pages in
+// "madvise" mode, the usual default): 512 times fewer faults.
 #pragma once
 
 #include <cstddef>

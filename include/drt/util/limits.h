@@ -1,7 +1,7 @@
 // How large a render may be. Every limit follows from one stated memory budget, or from the
 // integer widths the renderer counts in, and is checked before anything is allocated: a scene or
 // option past one is bad input (exit 2), not a render that runs the machine out of memory.
-// docs/scene-format.md and docs/usage.md give the same numbers with their reasons.
+// The "Limits" sections of docs/scene-format.md and docs/usage.md state them for users.
 #pragma once
 
 #include <cstdint>
@@ -48,7 +48,7 @@ int worker_threads(int threads);
 // times the text).
 inline constexpr std::uint64_t kMaxSceneBytes = std::uint64_t{64} << 20;  // 64 MiB
 // An OBJ file larger than this is refused while reading: 1 GiB of text holds about 30 million
-// vertices and twice as many triangles, whose 59 bytes each (mesh.h) already fill the budget.
+// vertices and twice as many triangles, a mesh that already takes most of the budget in memory.
 inline constexpr std::uint64_t kMaxObjBytes = std::uint64_t{1} << 30;
 // An image file larger than this is refused while reading: a .pfm of kMaxPixels with its header.
 inline constexpr std::uint64_t kMaxImageFileBytes = 12 * kMaxPixels + 4096;

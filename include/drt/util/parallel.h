@@ -1,7 +1,6 @@
-// One function run on several threads at once, as the renderer's workers and the costly-first
-// pilot run, or two halves of a divided task at once, as a mesh's tree build: the caller waits,
-// and an exception thrown on any thread comes back to it instead of ending the program (an
-// exception leaving a thread calls std::terminate).
+// One function run on several threads at once (the renderer's workers), or two halves of a
+// divided task at once (a mesh's tree build): the caller waits, and an exception thrown on any
+// thread comes back to it instead of ending the program through std::terminate.
 #pragma once
 
 #include <atomic>
