@@ -1,7 +1,7 @@
 // What one finished tile costs an MPI job's leader besides the transport: decoding the message
-// (tile_codec.h) and adding it to the image. The tiles of an 800 x 600 image are encoded once
-// and taken in turn, so each one arrives in memory the cache has not seen lately, as a message
-// from another process would.
+// (the checkpoint's tile format) and adding it to the image, the h of docs/scale-out.md's model.
+// The tiles of an 800 x 600 image are encoded once and taken in turn, so each one arrives in
+// memory the cache has not seen lately, as a message from another process would.
 #include <benchmark/benchmark.h>
 
 #include <cstdint>

@@ -49,7 +49,7 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
         c = compare_images(image_a, image_b);
     } catch (const ImageError& e) {
         return report_failure(e, "drt compare", "", err);
-    } catch (const std::bad_alloc& e) {
+    } catch (const std::bad_alloc& e) {  // any other failure reaches run_cli's last guard
         return report_failure(e, "drt compare", "", err);
     }
     out << comparison_fields(c) << "\n";

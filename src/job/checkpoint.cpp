@@ -22,10 +22,8 @@ namespace {
 
 using Bytes = std::vector<unsigned char>;
 
-// "DRTCKPT" and a format number: a reader refuses a format it does not know instead of guessing.
-// Format 2 added each pixel's spread and each tile's error sums (error_estimate.h); format 3
-// fingerprints each file the scene reads on its own (format 2 had one hash for them all); format 4
-// holds the error sums of the estimate's calibration instead of sobol's run spreads.
+// "DRTCKPT" and a format number, raised whenever the layout changes (the tile codec's included):
+// a reader refuses a format it does not know instead of guessing.
 constexpr char kMagic[8] = {'D', 'R', 'T', 'C', 'K', 'P', 'T', '4'};
 // The longest version string a reader accepts, so a damaged length cannot ask for gigabytes.
 constexpr std::uint32_t kMaxVersionLength = 256;
@@ -97,8 +95,8 @@ std::string printable_format(unsigned char c) {
     return "byte " + std::to_string(c);
 }
 
-// A checkpoint of the largest image the limits allow (28 bytes a pixel and a little per tile)
-// stays within the memory budget, as do the scene and mesh files a render reads.
+// A checkpoint of the largest image the limits allow fits the memory budget, as do the scene and
+// mesh files whose fingerprints it holds.
 Bytes read_all(const fs::path& file) {
     try {
         return read_binary_file(file, kMemoryBudget);
@@ -107,8 +105,8 @@ Bytes read_all(const fs::path& file) {
             case FileProblem::cannot_open:
                 fail(file, "cannot open file: " + e.reason());
             case FileProblem::too_large:
-                fail(file, "file larger than the " + std::to_string(kMemoryBudget >> 20) +
-                               " MiB limit for a checkpoint");
+                fail(file,
+                     "file larger than the " + std::to_string(kMemoryBudget >> 20) + " MiB limit");
             default:
                 fail(file, "cannot read file");
         }

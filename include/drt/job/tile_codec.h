@@ -1,6 +1,7 @@
 // One finished tile's buffer as bytes: what the processes of an MPI job send each other, and
 // what a checkpoint file stores for each tile. Little-endian whatever the host, so the bytes
 // move between machines, and exact: a decoded tile has every bit and count of the encoded one.
+// A change to the layout is a new checkpoint format (checkpoint.cpp numbers them).
 #pragma once
 
 #include <span>
