@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
+#include <exception>
 #include <filesystem>
 #include <iosfwd>
 #include <optional>
@@ -34,6 +35,17 @@ class LimitError : public std::runtime_error {
   public:
     using std::runtime_error::runtime_error;
 };
+
+// The status a command exits with after `error`, whose message it writes on `err`: bad input
+// (kBadInput) for a scene, image, checkpoint or limit error, a failure (kFailed) for any other,
+// out of memory included. Messages start with `command` ("drt converge"); a limit error and a
+// failure also name `subject` (printable: the scene the command works on) unless it is empty.
+int report_failure(const std::exception& error, const std::string& command,
+                   const std::string& subject, std::ostream& err);
+
+// The status of a render stopped before its end: 128 + the signal that stopped it, or
+// kInterrupted when --stop-after-tiles stood for one.
+int interrupted_status();
 
 // An integer option from `lowest` to `limit` (messages are made printable where they are shown).
 // CLI11's own range checks print a double's bounds in full (309 digits) and its unsigned conversion

@@ -3,7 +3,6 @@
 #include <cmath>
 #include <iomanip>
 #include <iostream>
-#include <new>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -173,21 +172,8 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
             text.pop_back();  // write_text_atomically ends the file with its own newline
             write_text_atomically(csv, text);
         }
-    } catch (const SceneError& e) {
-        err << e.what() << "\n";
-        return kBadInput;
-    } catch (const ImageError& e) {
-        err << "drt converge: " << e.what() << "\n";
-        return kBadInput;
-    } catch (const LimitError& e) {
-        err << "drt converge: " << printable(scene_path) << ": " << e.what() << "\n";
-        return kBadInput;
-    } catch (const std::bad_alloc&) {
-        err << "drt converge: " << printable(scene_path) << ": out of memory\n";
-        return kFailed;
     } catch (const std::exception& e) {
-        err << "drt converge: " << printable(scene_path) << ": " << printable(e.what()) << "\n";
-        return kFailed;
+        return report_failure(e, "drt converge", printable(scene_path), err);
     }
     return kOk;
 }

@@ -96,11 +96,9 @@ int info_command(int argc, const char* const* argv, std::ostream& out, std::ostr
         out << describe(loaded.scene, plan_render(loaded.scene));
         if (target) out << forecast_text(forecast(loaded.scene, *target, threads), *target);
     } catch (const SceneError& e) {
-        err << e.what() << "\n";
-        return kBadInput;
-    } catch (const LimitError& e) {
-        err << "drt info: " << printable(scene_path) << ": " << e.what() << "\n";
-        return kBadInput;
+        return report_failure(e, "drt info", printable(scene_path), err);
+    } catch (const LimitError& e) {  // bad input only: a failure reaches run_cli's last guard
+        return report_failure(e, "drt info", printable(scene_path), err);
     }
     return kOk;
 }

@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
-#include <new>
 #include <optional>
 #include <sstream>
 #include <stop_token>
@@ -19,7 +18,6 @@
 #include "cli_render.h"
 #include "drt/goal/progressive.h"
 #include "drt/io/image.h"
-#include "drt/job/checkpoint.h"
 #include "drt/job/mpi_work.h"
 #include "drt/job/render_job.h"
 #include "drt/render/error_estimate.h"
@@ -237,22 +235,9 @@ int guarded(const std::string& name, std::ostream& err, Step&& step) {
     try {
         step();
         return kOk;
-    } catch (const SceneError& e) {
-        err << e.what() << "\n";
-    } catch (const ImageError& e) {
-        err << "drt: " << e.what() << "\n";
-    } catch (const CheckpointError& e) {
-        err << "drt: " << printable(e.what()) << "\n";
-    } catch (const LimitError& e) {
-        err << "drt: " << name << ": " << e.what() << "\n";
-    } catch (const std::bad_alloc&) {
-        err << "drt: " << name << ": out of memory\n";
-        return kFailed;
     } catch (const std::exception& e) {
-        err << "drt: " << name << ": " << printable(e.what()) << "\n";
-        return kFailed;
+        return report_failure(e, "drt", name, err);
     }
-    return kBadInput;
 }
 
 // One scene, start to end. Everything that can go wrong ends here as a message and a status, so
@@ -340,7 +325,6 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
         return outcome;
     }
     if (!r.complete()) {
-        const int sig = stop_signal().load();
         err << "drt: " << name << ": interrupted with " << r.done << " of " << r.tiles
             << " tiles done; wrote " << printable(target.string());
         if (checkpoint) {
@@ -352,7 +336,7 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
         } else {
             err << "\ndrt: with --checkpoint FILE an interrupted render can be resumed\n";
         }
-        outcome.status = job.agree(sig != 0 ? 128 + sig : kInterrupted);
+        outcome.status = job.agree(interrupted_status());
         return outcome;
     }
     outcome.json = stats_json(
@@ -387,10 +371,9 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
     }
     if (rounds && rounds->stopped) {
         // Interrupted between or during rounds: the image is the complete rounds'.
-        const int sig = stop_signal().load();
         err << "drt: " << name << ": interrupted; kept "
             << (rounds->combined ? "the complete rounds combined\n" : "the last complete round\n");
-        outcome.status = job.agree(sig != 0 ? 128 + sig : kInterrupted);
+        outcome.status = job.agree(interrupted_status());
         return outcome;
     }
     // Written all the same, for inspection, but not a success: no pixel may be silently lost.

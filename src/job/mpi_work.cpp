@@ -19,7 +19,7 @@
 #include <thread>
 #include <vector>
 
-#include "drt/job/checkpoint.h"
+#include "drt/job/tile_codec.h"
 #include "drt/util/limits.h"
 
 namespace drt {
@@ -187,6 +187,17 @@ int receive_int(const Transport& transport, int from, int tag) {
     return value;
 }
 
+// A finished tile from process `from`; a damaged message is a failure of the job's transport.
+TileBuffer received_tile(std::span<const unsigned char> bytes, std::span<const Tile> grid,
+                         int from) {
+    try {
+        return decode_tile(bytes, grid);
+    } catch (const TileCodecError& e) {
+        throw std::runtime_error("MPI: a tile message from process " + std::to_string(from) + ": " +
+                                 e.what());
+    }
+}
+
 // The leader's tiles not handed out yet, shared by its own workers and the processes it serves.
 class LeaderQueue final : public TileSource {
   public:
@@ -276,8 +287,7 @@ void serve(const Transport& transport, const RenderContext& context, LeaderQueue
                 if (error) break;  // drain the others, but add nothing more
                 const Clock::time_point received = Clock::now();
                 try {
-                    sink.add(
-                        decode_tile(bytes, context.tiles(), "process " + std::to_string(from)));
+                    sink.add(received_tile(bytes, context.tiles(), from));
                 } catch (...) {
                     error = std::current_exception();
                     queue.close();

@@ -11,17 +11,14 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <functional>
 #include <map>
 #include <optional>
 #include <span>
 #include <string>
-#include <system_error>
 #include <type_traits>
 #include <vector>
 
@@ -31,6 +28,7 @@
 #include "drt/io/obj_reader.h"
 #include "drt/sampling/sampler.h"
 #include "drt/shading/texture.h"
+#include "drt/util/file_reader.h"
 #include "drt/util/limits.h"
 #include "drt/util/text.h"
 
@@ -793,34 +791,22 @@ class SceneReader {
     std::vector<std::filesystem::path> files_read_;
 };
 
-std::string read_file(const std::filesystem::path& path) {
-    const auto cannot_open = [&](int error) {
-        return SceneError(printable(path.string()) + ": cannot open scene: " +
-                          std::error_code(error, std::generic_category()).message());
-    };
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
-                                                         &std::fclose);
-    if (!file) throw cannot_open(errno);
-    std::string contents;
-    char buffer[1 << 16];
-    std::size_t n = 0;
-    while ((n = std::fread(buffer, 1, sizeof buffer, file.get())) > 0) {
-        // Checked while reading, so that an endless input (/dev/zero) stops too.
-        if (contents.size() + n > kMaxSceneBytes) {
+std::string read_scene_file(const std::filesystem::path& path) {
+    try {
+        return read_text_file(path, kMaxSceneBytes);
+    } catch (const FileReadError& e) {
+        if (e.problem() == FileProblem::too_large) {
             throw SceneError(printable(path.string()) + ": scene file larger than the " +
                              std::to_string(kMaxSceneBytes >> 20) + " MiB limit");
         }
-        contents.append(buffer, n);
+        throw SceneError(printable(path.string()) + ": cannot open scene: " + e.reason());
     }
-    // A directory opens fine on Linux and fails only when read (EISDIR).
-    if (std::ferror(file.get())) throw cannot_open(errno);
-    return contents;
 }
 
 }  // namespace
 
 LoadedScene load_scene(const std::filesystem::path& path) {
-    const std::string xml = read_file(path);
+    const std::string xml = read_scene_file(path);
     return SceneReader(path.string()).read(xml);
 }
 

@@ -100,6 +100,25 @@ TEST(Checkpoint, EveryDamagedByteAndEveryTruncationIsRefused) {
     }
 }
 
+// Tiles the checksum cannot catch, written so by a faulty writer: the tile codec's findings
+// come back in the checkpoint's words.
+TEST(Checkpoint, ARepeatedOrShortTileBehindAGoodChecksumIsRefusedInTheCheckpointsWords) {
+    const std::vector<Tile> grid = tile_grid(40, 28);
+    const auto message = [&](const std::vector<TileBuffer>& tiles) {
+        try {
+            decode_checkpoint(encode_checkpoint(identity_of(grid), tiles), grid, "ck.bin");
+        } catch (const CheckpointError& e) {
+            return std::string(e.what());
+        }
+        return std::string("decoded");
+    };
+    EXPECT_EQ(message({some_tile(grid[1], 1.0f), some_tile(grid[1], 2.0f)}),
+              "ck.bin: damaged checkpoint (bad tile index)");
+    TileBuffer short_tile = some_tile(grid[1], 1.0f);
+    short_tile.pixels = Image(1, 1);  // encodes fewer pixels than its tile has
+    EXPECT_EQ(message({short_tile}), "ck.bin: truncated checkpoint");
+}
+
 TEST(Checkpoint, IdentityCoversTheSceneBytesAndEverySettingButNotHowTheWorkIsDone) {
     const Scene scene = small_scene();
     const std::vector<fs::path> files{kEffects};

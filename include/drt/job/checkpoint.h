@@ -65,8 +65,8 @@ struct Checkpoint {
     std::vector<TileBuffer> tiles;  // finished, in any order
 };
 
-// The file's bytes: a header, the identity, each tile's pixels (linear floats), sample counts,
-// ray counts and tallies, and a checksum of all that.
+// The file's bytes: a header, the identity, each tile as tile_codec.h encodes it, and a checksum
+// of all that.
 std::vector<unsigned char> encode_checkpoint(const RenderIdentity& identity,
                                              std::span<const TileBuffer> tiles);
 
@@ -74,12 +74,6 @@ std::vector<unsigned char> encode_checkpoint(const RenderIdentity& identity,
 // whose tiles lie on `grid`.
 Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<const Tile> grid,
                              const std::filesystem::path& file);
-
-// One tile's buffer as bytes, as a checkpoint holds it and as processes send it to each other;
-// decode_tile throws CheckpointError naming `source` for bytes that are not one tile of `grid`.
-std::vector<unsigned char> encode_tile(const TileBuffer& tile);
-TileBuffer decode_tile(std::span<const unsigned char> bytes, std::span<const Tile> grid,
-                       const std::filesystem::path& source);
 
 // The checkpoint in `file` for the render `expected` over `grid`; nothing when there is no such
 // file. Throws CheckpointError when the file cannot be read, is damaged or truncated, or was
