@@ -229,6 +229,12 @@ fs::path partial_path(const fs::path& output) {
            (output.stem().string() + ".partial" + output.extension().string());
 }
 
+// `<stem>.nonfinite.pfm` beside the output: a render with non-finite pixels fails (exit 2) and
+// leaves the output as it was; the image is kept here, as a .pfm since it holds NaN and infinity.
+fs::path nonfinite_path(const fs::path& output) {
+    return output.parent_path() / (output.stem().string() + ".nonfinite.pfm");
+}
+
 // Runs `step`, turning every exception into a message and a status.
 template <typename Step>
 int guarded(const std::string& name, std::ostream& err, Step&& step) {
@@ -316,7 +322,10 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
     outcome.seconds = result.stats.seconds;
     outcome.mrays_per_second =
         result.stats.seconds > 0 ? result.stats.rays.total() / result.stats.seconds / 1e6 : 0;
-    const fs::path target = r.complete() ? output : partial_path(output);
+    const std::size_t nonfinite = r.complete() ? count_nonfinite(result.image) : 0;
+    const fs::path target = !r.complete()   ? partial_path(output)
+                            : nonfinite > 0 ? nonfinite_path(output)
+                                            : output;
     try {
         write_image(result.image, target, output_options(scene, result, job));
     } catch (const ImageError& e) {
@@ -360,7 +369,7 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
         if (r.resumed > 0) fs::remove(partial_path(output), ignored);
     }
     if (!job.quiet) {
-        err << "drt: wrote " << printable(output.string()) << " (" << outcome.width << "x"
+        err << "drt: wrote " << printable(target.string()) << " (" << outcome.width << "x"
             << outcome.height << ", " << outcome.samples << " spp, " << std::fixed
             << std::setprecision(2) << outcome.seconds << " s";
         if (r.resumed > 0) err << ", " << r.resumed << " of " << r.tiles << " tiles resumed";
@@ -376,11 +385,14 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
         outcome.status = job.agree(interrupted_status());
         return outcome;
     }
-    // Written all the same, for inspection, but not a success: no pixel may be silently lost.
-    if (const std::size_t bad = count_nonfinite(result.image)) {
-        err << "drt: " << name << ": " << bad << " of " << result.image.rgb.size()
+    // Kept for inspection, but not a success: no pixel may be silently lost.
+    if (nonfinite > 0) {
+        err << "drt: " << name << ": " << nonfinite << " of " << result.image.rgb.size()
             << " channel values are not finite (radiance beyond the float range: a light, "
-               "background or ambient too bright?)\n";
+               "background or ambient too bright?)\ndrt: "
+            << name << ": " << printable(output.string())
+            << " not written; the image is kept for inspection in " << printable(target.string())
+            << "\n";
         status = kBadInput;
     }
     outcome.status = job.agree(status);
