@@ -736,4 +736,9 @@ Object::SurfaceCoordinates Mesh::locate(const Ray& ray, const Hit& hit, SurfaceH
     return {fixed, fixed};
 }
 
+SurfaceUv Mesh::surface_uv(const Ray&, const Hit& hit, const SurfaceHit&) const {
+    const auto [a, b, c] = mesh_->corners(hit.primitive);
+    return {hit.uv, b - a, c - a};
+}
+
 }  // namespace drt

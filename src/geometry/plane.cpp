@@ -42,4 +42,11 @@ Object::SurfaceCoordinates Plane::locate(const Ray& ray, const Hit& hit,
     return {{dot(point, frame_.t), dot(point, frame_.b), 0}, point};
 }
 
+SurfaceUv Plane::surface_uv(const Ray&, const Hit&, const SurfaceHit& surface) const {
+    const double scale = detail().texture_scale;
+    return {{dot(surface.point, frame_.t) / scale, dot(surface.point, frame_.b) / scale},
+            frame_.t * scale,
+            frame_.b * scale};
+}
+
 }  // namespace drt

@@ -1,5 +1,6 @@
 #include "drt/geometry/sphere.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace drt {
@@ -23,6 +24,22 @@ Object::SurfaceCoordinates Sphere::locate(const Ray& ray, const Hit& hit,
     surface.normal = surface.shading_normal = surface.light_normal = normal;
     // Textures and bumps move with the sphere.
     return {point - c, point - c};
+}
+
+SurfaceUv Sphere::surface_uv(const Ray&, const Hit&, const SurfaceHit& surface) const {
+    const Vec3& d = surface.normal;
+    double phi = std::atan2(-d.z, d.x);
+    if (phi < 0) phi += 2 * kPi;
+    const double u = phi / (2 * kPi);
+    const double v = 1 - std::acos(std::clamp(d.y, -1.0, 1.0)) / kPi;
+    // ∂p/∂φ = r (dz, 0, −dx); ∂p/∂θ = r (cos θ cos φ, −sin θ, −cos θ sin φ), θ = π (1 − v).
+    const double sin_theta = std::sqrt(d.x * d.x + d.z * d.z);
+    const Vec3 dp_du = Vec3{d.z, 0, -d.x} * (2 * kPi * radius_);
+    const Vec3 dp_dv =
+        sin_theta > 0
+            ? Vec3{d.y * d.x / sin_theta, -sin_theta, d.y * d.z / sin_theta} * (-kPi * radius_)
+            : Vec3{};
+    return {{u, v}, dp_du, dp_dv};
 }
 
 }  // namespace drt

@@ -21,6 +21,18 @@ constexpr int kRedrawAttempts = 32;
 // (cos θ = 1 in the cone): a light whose area is not sampled acts as a point there.
 constexpr Vec2 kLightCentre{0, 0};
 
+// The surface at a hit. A camera ray filters image textures over the footprint of one of its
+// pixel's `samples` camera samples (1/√samples of a pixel across, as pbrt-v4 scales its
+// differentials, but at least an eighth); deeper rays, whose spread the camera does not know,
+// read the finest level.
+SurfaceHit surface_of(const Ray& ray, const Hit& hit, int depth, const Camera& camera,
+                      int samples) {
+    if (depth > 0 || !hit.object->detail().reads_uv()) return hit.object->surface_at(ray, hit);
+    const double step = std::max(0.125, 1 / std::sqrt(std::max(samples, 1)));
+    const RayDifferential differential = camera.differential(ray, step);
+    return hit.object->surface_at(ray, hit, &differential);
+}
+
 }  // namespace
 
 Vec3 reflect_above(const Vec3& d, const Vec3& shading, const Vec3& geometric) {
@@ -99,7 +111,7 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
     if (!hit) return scene_.background;
 
     const Material& m = hit->object->material();
-    const SurfaceHit surface = hit->object->surface_at(ray, *hit);
+    const SurfaceHit surface = surface_of(ray, *hit, depth, camera_, scene_.settings.samples);
     // Face both normals towards the incoming ray: planes are two-sided, and a ray inside a
     // sphere sees its inner side.
     const bool outside = dot(ray.dir, surface.normal) < 0;

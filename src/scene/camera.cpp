@@ -40,6 +40,16 @@ Ray Camera::generate_ray(Vec2 film, Vec2 lens_u, double time) const {
     return {origin, normalize(focus - origin), time};
 }
 
+RayDifferential Camera::differential(const Ray& ray, double step) const {
+    // Every ray through one film position meets the others on the plane in focus (at distance 1
+    // for a pinhole), where film steps are pixel_size_ · focal apart.
+    const double focal = lens_.is_pinhole() ? 1.0 : lens_.focal;
+    const Vec3 focus = ray.at(focal / dot(ray.dir, forward_));
+    const double film_step = pixel_size_ * focal * step;
+    return {{ray.origin, normalize(focus + right_ * film_step - ray.origin), ray.time},
+            {ray.origin, normalize(focus - up_ * film_step - ray.origin), ray.time}};
+}
+
 Vec2 concentric_disk(Vec2 u) {
     const double a = 2 * u.x - 1, b = 2 * u.y - 1;
     if (a == 0 && b == 0) return {0, 0};

@@ -10,6 +10,7 @@
 #include <tinyxml2.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -27,6 +28,8 @@
 #include "drt/geometry/sphere.h"
 #include "drt/io/obj_reader.h"
 #include "drt/sampling/sampler.h"
+#include "drt/scene/texture_cache.h"
+#include "drt/shading/image_texture.h"
 #include "drt/shading/texture.h"
 #include "drt/util/file_reader.h"
 #include "drt/util/limits.h"
@@ -285,13 +288,29 @@ struct SurfaceSpec {
     double texture_scale = 50;
     Color k2{0.1, 0.1, 0.1};
     std::optional<BumpMap> bump;
+    // Image textures ("Image textures, UV coordinates, OBJ materials, environment").
+    std::string texture_file, bump_file;  // as written in the scene; empty = none
+    std::shared_ptr<const MipMap> image, height;
+    double bump_strength = 0.3;
+    std::optional<std::array<Vec2, 3>> corner_uv;
+
+    bool image_texture() const { return textured && texture == kImageTexture; }
 
     SurfaceDetail build(const Material& material) const {
         SurfaceDetail detail;
-        if (textured) detail.texture = make_texture(texture, material.kd, k2, texture_scale);
+        if (image) {
+            detail.texture = std::make_shared<const ImageTexture>(image);
+        } else if (textured) {
+            detail.texture = make_texture(texture, material.kd, k2, texture_scale);
+        }
         detail.bump = bump;
+        if (height) detail.height_map = std::make_shared<const HeightMap>(height, bump_strength);
+        detail.texture_scale = texture_scale;
+        detail.corner_uv = corner_uv;
         return detail;
     }
+
+    static constexpr std::string_view kImageTexture = "image";
 };
 
 SurfaceSpec read_surface(Attributes& in) {
@@ -303,15 +322,22 @@ SurfaceSpec read_surface(Attributes& in) {
     s.k2 = in.color("k2r", "k2g", "k2b", {0.1, 0.1, 0.1});
     // Checked even when disabled, so that a misspelt name does not wait to be found until the
     // texture is switched on.
-    if (!make_texture(s.texture, {}, {}, 1))
+    if (s.texture != SurfaceSpec::kImageTexture && !make_texture(s.texture, {}, {}, 1))
         in.fail("unknown texture '" + abbreviated(s.texture) + "'");
+    if (s.image_texture()) {
+        s.texture_file = in.text("TextureFile");
+    } else {
+        in.find("TextureFile");  // known, unused while the image texture is off
+    }
+    s.bump_file = in.text("BumpFile", "");
 
     const bool bumped = in.flag("bumpEnable", false);
     BumpMap bump;
     bump.scale = in.number("BumpScale", bump.scale);
     in.check(bump.scale > 0, "BumpScale", "positive");
     bump.strength = in.number("BumpStrength", bump.strength);
-    if (bumped) s.bump = bump;
+    s.bump_strength = bump.strength;
+    if (bumped && s.bump_file.empty()) s.bump = bump;
     return s;
 }
 
@@ -652,6 +678,7 @@ class SceneReader {
         if (!normal) in.fail("zero-length normal");
         std::string material = in.text("Material");
         SurfaceSpec surface = read_surface(in);
+        load_images(in, surface);
         in.warn_unknown();
         warn_children(e);
         pending_.push_back({&e, std::move(material), std::move(surface),
@@ -685,6 +712,7 @@ class SceneReader {
         in.check(radius > 0, "Radius", "positive");
         std::string material = in.text("Material");
         SurfaceSpec surface = read_surface(in);
+        load_images(in, surface);
         in.warn_unknown();
         warn_stray_text(e);
 
@@ -706,6 +734,10 @@ class SceneReader {
         obj.normal_indices.assign(3, ObjMesh::kNoNormal);
         std::string material = in.text("Material");
         SurfaceSpec surface = read_surface(in);
+        surface.corner_uv = {Vec2{in.number("Au", 0), in.number("Av", 0)},
+                             Vec2{in.number("Bu", 1), in.number("Bv", 0)},
+                             Vec2{in.number("Cu", 0), in.number("Cv", 1)}};
+        load_images(in, surface);
         in.warn_unknown();
         warn_children(e);
         auto mesh = build_mesh(in, std::move(obj), {}, false);
@@ -728,6 +760,9 @@ class SceneReader {
         transform.rotate_degrees = in.vec3("RotateX", "RotateY", "RotateZ", {});
         const bool smooth = in.flag("Smooth", true);
         SurfaceSpec surface = read_surface(in);
+        // A mesh's (u, v) come from its OBJ file's `vt`, which the OBJ reader does not keep yet.
+        if (surface.image_texture() || !surface.bump_file.empty())
+            in.fail("image textures and BumpFile on a Mesh are not supported yet");
         in.warn_unknown();
         warn_stray_text(e);
         read_motion(e, "Tx", "Ty", "Tz", path);
@@ -754,6 +789,26 @@ class SceneReader {
              [mesh = std::move(mesh), path = std::move(path)](const Material& m, SurfaceDetail d) {
                  return std::make_unique<Mesh>(mesh, path, m, std::move(d));
              }});
+    }
+
+    // The images a surface names, relative to the scene file's folder, through the scene's cache.
+    void load_images(const Attributes& in, SurfaceSpec& surface) {
+        const auto load = [&](const std::string& file, TextureEncoding encoding) {
+            const std::filesystem::path path =
+                std::filesystem::path(context_.file()).parent_path() / file;
+            const std::size_t before = textures_.files_read();
+            try {
+                auto image = textures_.get(path, encoding);
+                if (textures_.files_read() > before) files_read_.push_back(path);
+                return image;
+            } catch (const ImageError& error) {
+                in.fail(error.what());
+            }
+        };
+        if (surface.image_texture())
+            surface.image = load(surface.texture_file, TextureEncoding::kColor);
+        if (!surface.bump_file.empty())
+            surface.height = load(surface.bump_file, TextureEncoding::kData);
     }
 
     static std::shared_ptr<const TriangleMesh> build_mesh(const Attributes& in, ObjMesh&& obj,
@@ -789,6 +844,7 @@ class SceneReader {
     std::map<std::string, int, std::less<>> material_lines_;
     std::vector<PendingObject> pending_;
     std::vector<std::filesystem::path> files_read_;
+    TextureCache textures_;
 };
 
 std::string read_scene_file(const std::filesystem::path& path) {

@@ -92,15 +92,16 @@ double turbulence(const Vec3& p, int octaves) {
     return sum;
 }
 
-Color CheckerTexture::value(const Vec3& local) const {
+Color CheckerTexture::value(const TexturePoint& at) const {
+    const Vec3& local = at.local;
     const auto cell = [&](double c) { return lattice(std::floor(c / scale_)); };
     // The parity of the sum from the parities: the sum itself could overflow.
     const long long parity = cell(local.x) ^ cell(local.y) ^ cell(local.z);
     return (parity & 1) == 0 ? a_ : b_;
 }
 
-Color MarbleTexture::value(const Vec3& local) const {
-    const Vec3 p = local / scale_;
+Color MarbleTexture::value(const TexturePoint& at) const {
+    const Vec3 p = at.local / scale_;
     const double t = 0.5 + 0.5 * std::sin(p.x + 5.0 * turbulence(p));
     return lerp(a_, b_, t);
 }

@@ -27,7 +27,9 @@ const Material& plain_material() {
 // Reports the texture coordinates it is evaluated at as its colour.
 class RecordingTexture final : public Texture {
   public:
-    Color value(const Vec3& local) const override { return {local.x, local.y, local.z}; }
+    Color value(const TexturePoint& at) const override {
+        return {at.local.x, at.local.y, at.local.z};
+    }
 };
 
 Vec3 as_vec(const Color& c) {

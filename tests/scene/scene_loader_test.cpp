@@ -169,8 +169,8 @@ TEST(SceneLoaderDefaults, EnabledTextureIsACheckerOfScale50BetweenKdAndDarkGray)
     const auto& texture = s.objects.at(0)->detail().texture;
     ASSERT_NE(texture, nullptr);
     ASSERT_NE(dynamic_cast<const CheckerTexture*>(texture.get()), nullptr);
-    expect_color(texture->value({49, 1, 1}), 1, 0, 0);
-    expect_color(texture->value({51, 1, 1}), 0.1, 0.1, 0.1);
+    expect_color(texture->value({{49, 1, 1}, {}, {}, {}}), 1, 0, 0);
+    expect_color(texture->value({{51, 1, 1}, {}, {}, {}}), 0.1, 0.1, 0.1);
 }
 
 TEST(SceneLoaderDefaults, EnabledBumpHasScale20AndStrength03) {
@@ -362,15 +362,15 @@ TEST(SceneLoader, TextureAttributesAreRead) {
                         .scene;
     const auto& checker = s.objects.at(0)->detail().texture;
     ASSERT_NE(dynamic_cast<const CheckerTexture*>(checker.get()), nullptr);
-    expect_color(checker->value({9, 1, 1}), 0, 0, 1);
-    expect_color(checker->value({11, 1, 1}), 1, 0.5, 0.25);
+    expect_color(checker->value({{9, 1, 1}, {}, {}, {}}), 0, 0, 1);
+    expect_color(checker->value({{11, 1, 1}, {}, {}, {}}), 1, 0.5, 0.25);
 
     const auto& marble = s.objects.at(1)->detail().texture;
     ASSERT_NE(dynamic_cast<const MarbleTexture*>(marble.get()), nullptr);
     // Marble blends between kd and the default k2, so every value lies between the two.
     const MarbleTexture expected({0, 0, 1}, {0.1, 0.1, 0.1}, 3);
     for (const Vec3 p : {Vec3{0.3, 1.7, 2.2}, Vec3{5, -4, 1.1}}) {
-        const Color c = marble->value(p), e = expected.value(p);
+        const Color c = marble->value({p, {}, {}, {}}), e = expected.value({p, {}, {}, {}});
         EXPECT_DOUBLE_EQ(c.r, e.r);
         EXPECT_DOUBLE_EQ(c.b, e.b);
     }

@@ -194,17 +194,17 @@ TEST(TextureBumpMap, TiltAtALatticePointIsTheStrengthAlongTheLatticeGradient) {
 TEST(TextureChecker, AlternatesByCellOfTheScale) {
     const Color a{1, 0, 0}, b{0, 0, 1};
     const CheckerTexture checker(a, b, 10);
-    EXPECT_EQ(checker.value({5, 5, 5}), a);
-    EXPECT_EQ(checker.value({15, 5, 5}), b);
-    EXPECT_EQ(checker.value({15, 15, 5}), a);
-    EXPECT_EQ(checker.value({15, 15, 15}), b);
+    EXPECT_EQ(checker.value({{5, 5, 5}, {}, {}, {}}), a);
+    EXPECT_EQ(checker.value({{15, 5, 5}, {}, {}, {}}), b);
+    EXPECT_EQ(checker.value({{15, 15, 5}, {}, {}, {}}), a);
+    EXPECT_EQ(checker.value({{15, 15, 15}, {}, {}, {}}), b);
     // Cells are half-open [k s, (k+1) s) and continue through negative coordinates.
-    EXPECT_EQ(checker.value({0, 0, 0}), a);
-    EXPECT_EQ(checker.value({-0.001, 0, 0}), b);
-    EXPECT_EQ(checker.value({-9.999, 0, 0}), b);
-    EXPECT_EQ(checker.value({-10.001, 0, 0}), a);
-    EXPECT_EQ(checker.value({9.999, 0, 0}), a);
-    EXPECT_EQ(checker.value({10, 0, 0}), b);
+    EXPECT_EQ(checker.value({{0, 0, 0}, {}, {}, {}}), a);
+    EXPECT_EQ(checker.value({{-0.001, 0, 0}, {}, {}, {}}), b);
+    EXPECT_EQ(checker.value({{-9.999, 0, 0}, {}, {}, {}}), b);
+    EXPECT_EQ(checker.value({{-10.001, 0, 0}, {}, {}, {}}), a);
+    EXPECT_EQ(checker.value({{9.999, 0, 0}, {}, {}, {}}), a);
+    EXPECT_EQ(checker.value({{10, 0, 0}, {}, {}, {}}), b);
 }
 
 TEST(TextureChecker, OnASphereIsRelativeToItsCentre) {
@@ -227,7 +227,7 @@ TEST(TextureChecker, OnASphereIsRelativeToItsCentre) {
         const auto ti = sphere.intersect(ray, {});
         ASSERT_TRUE(ti) << i;
         const SurfaceHit hit = sphere.surface_at(ray, *ti);
-        EXPECT_EQ(hit.kd, checker.value(hit.point - Vec3{7, 0, 0})) << i;
+        EXPECT_EQ(hit.kd, checker.value({hit.point - Vec3{7, 0, 0}, {}, {}, {}})) << i;
     }
 
     // A moving sphere carries its texture along.
@@ -238,7 +238,7 @@ TEST(TextureChecker, OnASphereIsRelativeToItsCentre) {
         const auto ti = moving.intersect(ray, {});
         ASSERT_TRUE(ti) << time;
         const SurfaceHit hit = moving.surface_at(ray, *ti);
-        EXPECT_EQ(hit.kd, checker.value(hit.point - c)) << time;
+        EXPECT_EQ(hit.kd, checker.value({hit.point - c, {}, {}, {}})) << time;
         EXPECT_EQ(hit.kd,
                   sphere.surface_at({Vec3{7, 0, 0} + Vec3{1.3, 30, 2.1}, {0, -1, 0}}, *ti).kd)
             << time;
@@ -250,7 +250,7 @@ TEST(TextureMarble, StaysBetweenItsTwoColours) {
     const MarbleTexture marble(a, b, 50);
     bool near_a = false, near_b = false;
     for (int i = 0; i < 5000; ++i) {
-        const Color c = marble.value(random_point(14, i, 500));
+        const Color c = marble.value({random_point(14, i, 500), {}, {}, {}});
         EXPECT_GE(c.r, 0.1 - 1e-12);
         EXPECT_LE(c.r, 0.9 + 1e-12);
         // A blend: the same weight in every channel.
@@ -271,7 +271,7 @@ TEST(TextureMarble, OnTheScaledLatticeIsTheBareSineWave) {
         for (int i = -20; i <= 20; i += 3) {
             const Vec3 lattice{double(i), double(i % 7), double(-2 * i)};
             const double w = 0.5 + 0.5 * std::sin(double(i));
-            const Color c = marble.value(lattice * scale);
+            const Color c = marble.value({lattice * scale, {}, {}, {}});
             EXPECT_NEAR(c.r, a.r + w * (b.r - a.r), 1e-12) << scale << " " << i;
             EXPECT_NEAR(c.b, a.b + w * (b.b - a.b), 1e-12) << scale << " " << i;
         }
@@ -282,8 +282,8 @@ TEST(TextureFactory, MakesKnownTexturesAndRejectsUnknownNames) {
     const Color a{1, 0, 0}, b{0, 1, 0};
     const auto checker = make_texture("checker", a, b, 10);
     ASSERT_NE(checker, nullptr);
-    EXPECT_EQ(checker->value({5, 5, 5}), a);
-    EXPECT_EQ(checker->value({15, 5, 5}), b);
+    EXPECT_EQ(checker->value({{5, 5, 5}, {}, {}, {}}), a);
+    EXPECT_EQ(checker->value({{15, 5, 5}, {}, {}, {}}), b);
     EXPECT_NE(make_texture("marble", a, b, 10), nullptr);
     EXPECT_EQ(make_texture("wood", a, b, 10), nullptr);
     EXPECT_EQ(make_texture("", a, b, 10), nullptr);
@@ -303,21 +303,23 @@ TEST(TextureRobustness, TinyScalesAndHugeCoordinatesStayDefined) {
     const Color a{1, 0, 0}, b{0, 0, 1};
     const auto checker = make_texture("checker", a, b, 1e-300);
     for (const Vec3 p : {Vec3{1, 2, 3}, Vec3{-1e10, 5e9, 1e-290}, Vec3{1e308, -1e308, 0}}) {
-        const Color c = checker->value(p);
+        const Color c = checker->value({p, {}, {}, {}});
         EXPECT_EQ(c.r, a.r) << p.x;
         EXPECT_EQ(c.b, a.b) << p.x;
     }
     // Within range the parity still alternates, including for negative cells.
     const auto unit = make_texture("checker", a, b, 1);
-    EXPECT_EQ(unit->value({0.5, 0.5, 0.5}).r, a.r);
-    EXPECT_EQ(unit->value({1.5, 0.5, 0.5}).r, b.r);
-    EXPECT_EQ(unit->value({-0.5, 0.5, 0.5}).r, b.r);
-    EXPECT_EQ(unit->value({-0.5, -0.5, 0.5}).r, a.r);
+    EXPECT_EQ(unit->value({{0.5, 0.5, 0.5}, {}, {}, {}}).r, a.r);
+    EXPECT_EQ(unit->value({{1.5, 0.5, 0.5}, {}, {}, {}}).r, b.r);
+    EXPECT_EQ(unit->value({{-0.5, 0.5, 0.5}, {}, {}, {}}).r, b.r);
+    EXPECT_EQ(unit->value({{-0.5, -0.5, 0.5}, {}, {}, {}}).r, a.r);
     for (const double v : {1e19, -1e19, 1e300, -1e300}) {
         EXPECT_TRUE(std::isfinite(perlin_noise({v, v, v}))) << v;
     }
     for (const double v : {1e19, -1e19}) {  // 1e29 in the noise's lattice units
-        EXPECT_TRUE(std::isfinite(make_texture("marble", a, b, 1e-10)->value({v, 1, 2}).r)) << v;
+        EXPECT_TRUE(
+            std::isfinite(make_texture("marble", a, b, 1e-10)->value({{v, 1, 2}, {}, {}, {}}).r))
+            << v;
     }
     BumpMap bump;
     bump.scale = 1e-10;

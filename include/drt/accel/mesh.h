@@ -158,6 +158,8 @@ class Mesh final : public Object {
 
   protected:
     SurfaceCoordinates locate(const Ray& ray, const Hit& hit, SurfaceHit& surface) const override;
+    // A triangle's own (u, v): the barycentrics (b1, b2) of the hit.
+    SurfaceUv surface_uv(const Ray& ray, const Hit& hit, const SurfaceHit& surface) const override;
 
   private:
     std::shared_ptr<const TriangleMesh> mesh_;

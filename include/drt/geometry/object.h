@@ -4,12 +4,14 @@
 // the one hit a ray keeps, for its surface.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <vector>
 
 #include "drt/geometry/motion.h"
+#include "drt/shading/image_texture.h"
 #include "drt/shading/material.h"
 #include "drt/shading/texture.h"
 #include "drt/util/color.h"
@@ -76,6 +78,20 @@ struct Shapes {
 struct SurfaceDetail {
     std::shared_ptr<const Texture> texture;  // replaces the material's kd; null = none
     std::optional<BumpMap> bump;
+    // Image-mapped surfaces (../shared/spec/scene-format.md, "Image textures, UV coordinates").
+    std::shared_ptr<const HeightMap> height_map;  // bumps instead of `bump`'s noise; null = none
+    double texture_scale = 1;                     // a plane's (u, v) are its coordinates over this
+    // A lone triangle's corner (u, v) for A, B, C: its own (u, v) are the barycentrics (b1, b2),
+    // which these map affinely.
+    std::optional<std::array<Vec2, 3>> corner_uv;
+
+    bool reads_uv() const { return height_map || (texture && texture->reads_uv()); }
+};
+
+// A surface's texture coordinates at a point and how the point moves as they grow.
+struct SurfaceUv {
+    Vec2 uv;
+    Vec3 dp_du, dp_dv;
 };
 
 class Object {
@@ -97,8 +113,10 @@ class Object {
     virtual double motion_end() const { return 0; }
     bool moves() const { return motion_end() > 0; }
 
-    // Surface information at a hit on this object by `ray`.
-    SurfaceHit surface_at(const Ray& ray, const Hit& hit) const;
+    // Surface information at a hit on this object by `ray`. An image texture is filtered over
+    // the footprint of `differential` where given (camera rays), else read at its finest level.
+    SurfaceHit surface_at(const Ray& ray, const Hit& hit,
+                          const RayDifferential* differential = nullptr) const;
 
   protected:
     // Where a texture and a bump map are evaluated at a hit: coordinates fixed to a moving
@@ -112,6 +130,9 @@ class Object {
     // interpolated) and where shadow rays leave. In place, so the record is not copied per hit.
     virtual SurfaceCoordinates locate(const Ray& ray, const Hit& hit,
                                       SurfaceHit& surface) const = 0;
+    // The surface's (u, v) at a hit that `locate` has filled `surface` for, asked only of an
+    // object with an image texture or height map. The default has no coordinates: (0, 0).
+    virtual SurfaceUv surface_uv(const Ray& ray, const Hit& hit, const SurfaceHit& surface) const;
 
   private:
     const Material* material_;

@@ -43,6 +43,8 @@ class Plane final : public Object {
     // Textures are evaluated in the plane's own 2-D coordinates (about the world origin's
     // projection), so a checker on a plane through the origin has a cell corner there.
     SurfaceCoordinates locate(const Ray& ray, const Hit& hit, SurfaceHit& surface) const override;
+    // (u, v) are the point's coordinates along the in-plane axes over TextureScale.
+    SurfaceUv surface_uv(const Ray& ray, const Hit& hit, const SurfaceHit& surface) const override;
 
   private:
     Vec3 point_;

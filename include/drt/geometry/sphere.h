@@ -25,6 +25,9 @@ class Sphere final : public Object {
 
   protected:
     SurfaceCoordinates locate(const Ray& ray, const Hit& hit, SurfaceHit& surface) const override;
+    // u = φ/2π with φ = atan2(−dz, dx) in [0, 2π), v = 1 − θ/π with θ = acos(dy), for the unit
+    // direction d from the centre: the image's top row is +y, its left edge +x.
+    SurfaceUv surface_uv(const Ray& ray, const Hit& hit, const SurfaceHit& surface) const override;
 
   private:
     MotionPath path_;

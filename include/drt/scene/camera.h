@@ -32,6 +32,9 @@ class Camera {
     // The ray through film position `film` (pixel units, x right, y down, pixel (i, j) covering
     // [i, i+1] x [j, j+1]); `lens_u` picks the lens point and is ignored by a pinhole.
     Ray generate_ray(Vec2 film, Vec2 lens_u, double time) const;
+    // The differentials of a ray from generate_ray: the rays from the same lens point through
+    // the film positions `step` pixels right and down of its own.
+    RayDifferential differential(const Ray& ray, double step) const;
     bool has_lens() const { return !lens_.is_pinhole(); }
     const Vec3& eye() const { return eye_; }
     const Vec3& forward() const { return forward_; }

@@ -16,18 +16,30 @@ double perlin_noise(const Vec3& p);
 // Sum of |noise| over octaves (Perlin's turbulence), about [0, 1).
 double turbulence(const Vec3& p, int octaves = 6);
 
+// Where a texture is looked up: the point in the object's own 3-D texture coordinates, which
+// procedural textures read, and the surface's (u, v) with the footprint of the sample around it,
+// which image textures read (both are filled only for a texture that asks for them).
+struct TexturePoint {
+    Vec3 local;
+    Vec2 uv;
+    // Change of (u, v) to the neighbouring camera samples across and down the image; zero when
+    // unknown, which reads the image's finest level.
+    Vec2 duv_dx, duv_dy;
+};
+
 class Texture {
   public:
     virtual ~Texture() = default;
-    // Colour at a point in the object's own texture coordinates (Object::texture_point).
-    virtual Color value(const Vec3& local) const = 0;
+    virtual Color value(const TexturePoint& at) const = 0;
+    // Whether value() reads the surface's (u, v), which the object then works out.
+    virtual bool reads_uv() const { return false; }
 };
 
 // Cells of edge `scale` alternating between two colours.
 class CheckerTexture final : public Texture {
   public:
     CheckerTexture(Color a, Color b, double scale) : a_(a), b_(b), scale_(scale) {}
-    Color value(const Vec3& local) const override;
+    Color value(const TexturePoint& at) const override;
 
   private:
     Color a_, b_;
@@ -38,7 +50,7 @@ class CheckerTexture final : public Texture {
 class MarbleTexture final : public Texture {
   public:
     MarbleTexture(Color a, Color b, double scale) : a_(a), b_(b), scale_(scale) {}
-    Color value(const Vec3& local) const override;
+    Color value(const TexturePoint& at) const override;
 
   private:
     Color a_, b_;

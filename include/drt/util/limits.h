@@ -53,4 +53,8 @@ inline constexpr std::uint64_t kMaxObjBytes = std::uint64_t{1} << 30;
 // An image file larger than this is refused while reading: a .pfm of kMaxPixels with its header.
 inline constexpr std::uint64_t kMaxImageFileBytes = 12 * kMaxPixels + 4096;
 
+// The image textures of a scene together, their mip-maps included: half the budget, leaving the
+// rest to the rendered image, the meshes and the renderer's own memory.
+inline constexpr std::uint64_t kMaxTextureBytes = kMemoryBudget / 2;
+
 }  // namespace drt

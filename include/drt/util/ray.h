@@ -13,4 +13,11 @@ struct Ray {
     constexpr Vec3 at(double t) const { return origin + dir * t; }
 };
 
+// The rays through the neighbouring camera samples, one step right and one step down the image
+// from a camera ray (ray differentials, as in pbrt): where they meet a surface's tangent plane
+// gives the footprint over which a texture is filtered.
+struct RayDifferential {
+    Ray dx, dy;
+};
+
 }  // namespace drt

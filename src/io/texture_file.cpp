@@ -1,0 +1,183 @@
+#include "drt/io/texture_file.h"
+
+#include <stb_image.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "drt/io/exr.h"
+#include "drt/util/file_reader.h"
+#include "drt/util/limits.h"
+#include "drt/util/text.h"
+
+namespace drt {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Bytes = std::vector<unsigned char>;
+
+[[noreturn]] void fail(const fs::path& path, const std::string& what) {
+    throw ImageError(printable(path.string()) + ": " + what);
+}
+
+bool starts_with(const Bytes& data, std::string_view magic) {
+    return data.size() >= magic.size() && std::memcmp(data.data(), magic.data(), magic.size()) == 0;
+}
+
+enum class Kind { kPng, kJpeg, kBmp, kTga, kHdr, kExr };
+
+// The format from the file's first bytes. TGA has no signature: a file none of the others claim
+// is taken for one if stb's TGA header check accepts it.
+Kind kind_of(const Bytes& data, const fs::path& path) {
+    if (starts_with(data, std::string_view("\x89PNG\r\n\x1a\n", 8))) return Kind::kPng;
+    if (starts_with(data, "\xff\xd8\xff")) return Kind::kJpeg;
+    if (starts_with(data, "BM")) return Kind::kBmp;
+    if (starts_with(data, "#?RADIANCE") || starts_with(data, "#?RGBE")) return Kind::kHdr;
+    if (starts_with(data, "\x76\x2f\x31\x01")) return Kind::kExr;
+    int w = 0, h = 0, channels = 0;
+    if (data.size() >= 18 &&
+        stbi_info_from_memory(data.data(), static_cast<int>(data.size()), &w, &h, &channels))
+        return Kind::kTga;
+    fail(path, "not a PNG, JPEG, BMP, TGA, Radiance HDR or OpenEXR image");
+}
+
+// stb reads through these callbacks and sees a zero byte past the end of the data, which for
+// several formats decodes a truncated file as black pixels instead of failing; the reader
+// remembers being asked for bytes that are not there.
+struct CallbackReader {
+    const Bytes& data;
+    std::size_t pos = 0;
+    bool past_end = false;
+
+    static int read(void* user, char* out, int size) {
+        auto& r = *static_cast<CallbackReader*>(user);
+        const std::size_t left = r.data.size() - r.pos;
+        const std::size_t n = std::min(left, static_cast<std::size_t>(size));
+        if (n == 0 && size > 0) r.past_end = true;
+        std::memcpy(out, r.data.data() + r.pos, n);
+        r.pos += n;
+        return static_cast<int>(n);
+    }
+    static void skip(void* user, int n) {
+        auto& r = *static_cast<CallbackReader*>(user);
+        if (n < 0) {
+            r.pos -= std::min(r.pos, static_cast<std::size_t>(-static_cast<long long>(n)));
+            return;
+        }
+        if (static_cast<std::size_t>(n) > r.data.size() - r.pos) r.past_end = true;
+        r.pos = std::min(r.data.size(), r.pos + static_cast<std::size_t>(n));
+    }
+    static int eof(void* user) {
+        const auto& r = *static_cast<CallbackReader*>(user);
+        return r.pos >= r.data.size() ? 1 : 0;
+    }
+};
+
+using StbPixels = std::unique_ptr<void, decltype(&stbi_image_free)>;
+
+// Linear value of every 8-bit code under the sRGB curve, or code / 255 for data.
+std::array<float, 256> table_8bit(TextureEncoding encoding) {
+    std::array<float, 256> table{};
+    for (int i = 0; i < 256; ++i) {
+        const double v = i / 255.0;
+        table[static_cast<std::size_t>(i)] =
+            static_cast<float>(encoding == TextureEncoding::kColor ? decode_srgb(v) : v);
+    }
+    return table;
+}
+
+Image decode_stb(const Bytes& data, const fs::path& path, Kind kind, TextureEncoding encoding) {
+    if (data.size() > static_cast<std::size_t>(INT32_MAX)) fail(path, "file too large");
+    const int size = static_cast<int>(data.size());
+    int w = 0, h = 0, channels = 0;
+    if (!stbi_info_from_memory(data.data(), size, &w, &h, &channels) || w <= 0 || h <= 0)
+        fail(path, "cannot decode image: bad or truncated header");
+    // The size from the header alone, before stb allocates for it.
+    if (w > kMaxImageSide || h > kMaxImageSide ||
+        std::uint64_t(w) * std::uint64_t(h) > kMaxPixels) {
+        fail(path, "image of " + std::to_string(w) + "x" + std::to_string(h) +
+                       " pixels exceeds the limit of " + std::to_string(kMaxPixels) + " pixels");
+    }
+    CallbackReader reader{data};
+    const stbi_io_callbacks callbacks{&CallbackReader::read, &CallbackReader::skip,
+                                      &CallbackReader::eof};
+    const bool hdr = kind == Kind::kHdr;
+    const bool wide = !hdr && stbi_is_16_bit_from_memory(data.data(), size);
+    StbPixels pixels(nullptr, &stbi_image_free);
+    if (hdr) {
+        pixels.reset(stbi_loadf_from_callbacks(&callbacks, &reader, &w, &h, &channels, 3));
+    } else if (wide) {
+        pixels.reset(stbi_load_16_from_callbacks(&callbacks, &reader, &w, &h, &channels, 3));
+    } else {
+        pixels.reset(stbi_load_from_callbacks(&callbacks, &reader, &w, &h, &channels, 3));
+    }
+    if (!pixels) {
+        const char* reason = stbi_failure_reason();
+        fail(path, std::string("cannot decode image: ") + (reason ? reason : "unknown error"));
+    }
+    if (reader.past_end) fail(path, "truncated image file");
+    Image image(w, h);
+    if (hdr) {
+        const float* p = static_cast<const float*>(pixels.get());
+        std::copy(p, p + image.rgb.size(), image.rgb.begin());
+    } else if (wide) {
+        const auto* p = static_cast<const stbi_us*>(pixels.get());
+        std::transform(p, p + image.rgb.size(), image.rgb.begin(), [&](stbi_us v) {
+            const double x = v / 65535.0;
+            return static_cast<float>(encoding == TextureEncoding::kColor ? decode_srgb(x) : x);
+        });
+    } else {
+        const std::array<float, 256> table = table_8bit(encoding);
+        const auto* p = static_cast<const stbi_uc*>(pixels.get());
+        std::transform(p, p + image.rgb.size(), image.rgb.begin(),
+                       [&](stbi_uc v) { return table[v]; });
+    }
+    for (const float v : image.rgb) {
+        if (!std::isfinite(v)) fail(path, "image holds a value that is not a finite number");
+    }
+    return image;
+}
+
+}  // namespace
+
+Image decode_texture(const Bytes& data, const fs::path& path, TextureEncoding encoding) {
+    const Kind kind = kind_of(data, path);
+    if (kind != Kind::kExr) return decode_stb(data, path, kind, encoding);
+    Image image = decode_exr(data, path);
+    for (const float v : image.rgb) {
+        if (!std::isfinite(v)) fail(path, "image holds a value that is not a finite number");
+    }
+    return image;
+}
+
+Image read_texture(const fs::path& path, TextureEncoding encoding) {
+    Bytes data;
+    try {
+        data = read_binary_file(path, kMaxImageFileBytes, FileKinds::regular_only);
+    } catch (const FileReadError& e) {
+        switch (e.problem()) {
+            case FileProblem::cannot_open:
+                fail(path, "cannot open file: " + e.reason());
+            case FileProblem::cannot_read:
+                fail(path, "cannot read file: " + e.reason());
+            case FileProblem::is_folder:
+                fail(path, "is a folder, not an image file");
+            case FileProblem::not_regular_file:
+                fail(path, "not a regular file");
+            case FileProblem::too_large:
+                break;
+        }
+        fail(path, "file larger than the " + std::to_string(kMaxImageFileBytes >> 20) +
+                       " MiB limit for an image");
+    }
+    return decode_texture(data, path, encoding);
+}
+
+}  // namespace drt
