@@ -96,15 +96,28 @@ std::array<float, 256> table_8bit(TextureEncoding encoding) {
 Image decode_stb(const Bytes& data, const fs::path& path, Kind kind, TextureEncoding encoding) {
     if (data.size() > static_cast<std::size_t>(INT32_MAX)) fail(path, "file too large");
     const int size = static_cast<int>(data.size());
-    int w = 0, h = 0, channels = 0;
-    if (!stbi_info_from_memory(data.data(), size, &w, &h, &channels) || w <= 0 || h <= 0)
-        fail(path, "cannot decode image: bad or truncated header");
-    // The size from the header alone, before stb allocates for it.
-    if (w > kMaxImageSide || h > kMaxImageSide ||
-        std::uint64_t(w) * std::uint64_t(h) > kMaxPixels) {
-        fail(path, "image of " + std::to_string(w) + "x" + std::to_string(h) +
-                       " pixels exceeds the limit of " + std::to_string(kMaxPixels) + " pixels");
+    const auto check_size = [&](std::uint64_t w, std::uint64_t h) {
+        if (w > kMaxImageSide || h > kMaxImageSide || w * h > kMaxPixels) {
+            fail(path, "image of " + std::to_string(w) + "x" + std::to_string(h) +
+                           " pixels exceeds the limit of " + std::to_string(kMaxPixels) +
+                           " pixels");
+        }
+    };
+    // stb refuses a huge PNG from its header too, but says only "too large": read the size.
+    if (kind == Kind::kPng && data.size() >= 24) {
+        const auto u32 = [&](std::size_t i) {
+            return std::uint64_t{data[i]} << 24 | std::uint64_t{data[i + 1]} << 16 |
+                   std::uint64_t{data[i + 2]} << 8 | data[i + 3];
+        };
+        check_size(u32(16), u32(20));
     }
+    int w = 0, h = 0, channels = 0;
+    if (!stbi_info_from_memory(data.data(), size, &w, &h, &channels) || w <= 0 || h <= 0) {
+        const char* reason = stbi_failure_reason();
+        fail(path, std::string("cannot decode image header: ") + (reason ? reason : "corrupt"));
+    }
+    // The size from the header alone, before stb allocates for it.
+    check_size(static_cast<std::uint64_t>(w), static_cast<std::uint64_t>(h));
     CallbackReader reader{data};
     const stbi_io_callbacks callbacks{&CallbackReader::read, &CallbackReader::skip,
                                       &CallbackReader::eof};

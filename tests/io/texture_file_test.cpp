@@ -1,0 +1,154 @@
+#include "drt/io/texture_file.h"
+
+#include <gtest/gtest.h>
+#include <stb_image_write.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "drt/io/exr.h"
+
+// Part of libstb's stb_image_write, which its header declares only inside the implementation.
+extern "C" unsigned char* stbi_zlib_compress(unsigned char* data, int data_len, int* out_len,
+                                             int quality);
+
+namespace drt {
+namespace {
+
+using Bytes = std::vector<unsigned char>;
+
+void append(void* context, void* data, int size) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    static_cast<Bytes*>(context)->insert(static_cast<Bytes*>(context)->end(), p, p + size);
+}
+
+// A 2 x 1 RGB image, pixel 0 = (a, b, c), pixel 1 = (c, b, a), in the format `kind`.
+Bytes encoded(const std::string& kind, unsigned char a, unsigned char b, unsigned char c) {
+    const unsigned char rgb[6] = {a, b, c, c, b, a};
+    Bytes out;
+    stbi_write_tga_with_rle = 0;
+    if (kind == "png") stbi_write_png_to_func(append, &out, 2, 1, 3, rgb, 6);
+    if (kind == "bmp") stbi_write_bmp_to_func(append, &out, 2, 1, 3, rgb);
+    if (kind == "tga") stbi_write_tga_to_func(append, &out, 2, 1, 3, rgb);
+    if (kind == "jpg") stbi_write_jpg_to_func(append, &out, 2, 1, 3, rgb, 100);
+    return out;
+}
+
+Image decode(const Bytes& data, TextureEncoding encoding = TextureEncoding::kColor) {
+    return decode_texture(data, "t.img", encoding);
+}
+
+std::string error_of(const Bytes& data) {
+    try {
+        decode(data);
+    } catch (const ImageError& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+// 8-bit colour is sRGB-encoded: 188 decodes to 0.5029 (a 2 % change of the curve misses the
+// tolerance), 0 and 255 to exactly 0 and 1. Data maps keep code / 255.
+TEST(TextureFile, EightBitColourIsDecodedFromSrgbAndDataIsLinear) {
+    for (const std::string kind : {"png", "bmp", "tga"}) {
+        const Image image = decode(encoded(kind, 188, 0, 255));
+        ASSERT_EQ(image.width, 2) << kind;
+        ASSERT_EQ(image.height, 1) << kind;
+        EXPECT_NEAR(image.at(0, 0).r, 0.50289, 2e-4) << kind;
+        EXPECT_EQ(image.at(0, 0).g, 0.0f) << kind;
+        EXPECT_EQ(image.at(0, 0).b, 1.0f) << kind;
+        EXPECT_EQ(image.at(1, 0).r, 1.0f) << kind;  // the second pixel: left to right
+        const Image data = decode(encoded(kind, 188, 0, 255), TextureEncoding::kData);
+        EXPECT_NEAR(data.at(0, 0).r, 188 / 255.0, 1e-7) << kind;
+    }
+}
+
+TEST(TextureFile, JpegDecodesNearItsColours) {
+    const Image image = decode(encoded("jpg", 188, 188, 188));
+    EXPECT_NEAR(image.at(0, 0).g, 0.503, 0.02);
+}
+
+TEST(TextureFile, RadianceHdrAndExrAreLinear) {
+    const float rgb[6] = {0.25f, 2.5f, 16.0f, 1, 1, 1};
+    Bytes hdr;
+    stbi_write_hdr_to_func(append, &hdr, 2, 1, 3, rgb);
+    const Image h = decode(hdr);
+    EXPECT_NEAR(h.at(0, 0).r, 0.25, 0.25 / 128);  // RGBE keeps 8 bits of mantissa
+    EXPECT_NEAR(h.at(0, 0).g, 2.5, 2.5 / 128);
+    EXPECT_NEAR(h.at(0, 0).b, 16.0, 16.0 / 128);
+
+    Image image(2, 1);
+    image.set(0, 0, {0.25, 2.5, 16});
+    const Image e = decode(encode_exr(image, {}, "t.exr"));
+    EXPECT_EQ(e.at(0, 0).r, 0.25f);
+    EXPECT_EQ(e.at(0, 0).b, 16.0f);
+}
+
+TEST(TextureFile, SixteenBitPngIsDecodedFromSrgb) {
+    // stb writes no 16-bit PNG: build one, 1 x 1 RGB, every channel 0xBCBC = 188 · 257.
+    const auto chunk = [](Bytes& png, const char* kind, const Bytes& body) {
+        for (const int shift : {24, 16, 8, 0})
+            png.push_back(static_cast<unsigned char>(body.size() >> shift));
+        png.insert(png.end(), kind, kind + 4);
+        png.insert(png.end(), body.begin(), body.end());
+        png.insert(png.end(), 4, 0);  // CRC, which stb does not check
+    };
+    Bytes png{0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    chunk(png, "IHDR", {0, 0, 0, 1, 0, 0, 0, 1, 16, 2, 0, 0, 0});
+    unsigned char row[7] = {0, 0xBC, 0xBC, 0xBC, 0xBC, 0xBC, 0xBC};
+    int size = 0;
+    unsigned char* z = stbi_zlib_compress(row, 7, &size, 8);
+    chunk(png, "IDAT", Bytes(z, z + size));
+    std::free(z);
+    chunk(png, "IEND", {});
+    const Image image = decode(png);
+    EXPECT_NEAR(image.at(0, 0).r, 0.50289, 2e-4);
+    EXPECT_NEAR(decode(png, TextureEncoding::kData).at(0, 0).g, 188 / 255.0, 1e-7);
+}
+
+TEST(TextureFile, FormatsAreToldByContentNotName) {
+    EXPECT_NE(error_of(Bytes{'h', 'e', 'l', 'l', 'o'}).find("not a PNG, JPEG, BMP, TGA"),
+              std::string::npos);
+    EXPECT_NE(error_of({}).find("t.img: "), std::string::npos);
+}
+
+// A header claiming 100000 x 100000 pixels is refused from the header, before stb allocates 30 GB.
+TEST(TextureFile, HostileSizeIsRefusedFromTheHeader) {
+    Bytes png = encoded("png", 1, 2, 3);
+    // IHDR's width and height, big-endian at bytes 16 and 20; the CRC no longer matches,
+    // which stb's header check does not look at.
+    for (const int at : {16, 20}) {
+        png[at] = 0, png[at + 1] = 0x01, png[at + 2] = 0x86, png[at + 3] = 0xA0;  // 100000
+    }
+    const std::string message = error_of(png);
+    EXPECT_NE(message.find("100000x100000 pixels exceeds the limit"), std::string::npos) << message;
+
+    Bytes tga = encoded("tga", 1, 2, 3);
+    tga[12] = 0xA0, tga[13] = 0x86, tga[14] = 0xA0, tga[15] = 0x86;  // 34464 x 34464, > 2^27
+    EXPECT_NE(error_of(tga).find("exceeds the limit"), std::string::npos) << error_of(tga);
+}
+
+// Files cut short are an error, never pixels made up from missing bytes.
+TEST(TextureFile, TruncatedFilesAreErrors) {
+    const unsigned char grey[3 * 64 * 64] = {};
+    for (const std::string kind : {"png", "bmp", "tga", "jpg", "hdr"}) {
+        Bytes full;
+        if (kind == "png") stbi_write_png_to_func(append, &full, 64, 64, 3, grey, 3 * 64);
+        if (kind == "bmp") stbi_write_bmp_to_func(append, &full, 64, 64, 3, grey);
+        if (kind == "tga") stbi_write_tga_to_func(append, &full, 64, 64, 3, grey);
+        if (kind == "jpg") stbi_write_jpg_to_func(append, &full, 64, 64, 3, grey, 90);
+        if (kind == "hdr") {
+            const std::vector<float> f(3 * 64 * 64, 0.5f);
+            stbi_write_hdr_to_func(append, &full, 64, 64, 3, f.data());
+        }
+        EXPECT_NO_THROW(decode(full)) << kind;
+        const Bytes cut(full.begin(), full.begin() + static_cast<std::ptrdiff_t>(full.size() / 2));
+        EXPECT_THROW(decode(cut), ImageError) << kind;
+    }
+}
+
+}  // namespace
+}  // namespace drt
