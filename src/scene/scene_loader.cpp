@@ -292,6 +292,7 @@ struct SurfaceSpec {
     std::string texture_file, bump_file;  // as written in the scene; empty = none
     std::shared_ptr<const MipMap> image, height;
     double bump_strength = 0.3;
+    TextureFilter filter = TextureFilter::kAnisotropic;
     std::optional<std::array<Vec2, 3>> corner_uv;
 
     bool image_texture() const { return textured && texture == kImageTexture; }
@@ -299,12 +300,13 @@ struct SurfaceSpec {
     SurfaceDetail build(const Material& material) const {
         SurfaceDetail detail;
         if (image) {
-            detail.texture = std::make_shared<const ImageTexture>(image);
+            detail.texture = std::make_shared<const ImageTexture>(image, filter);
         } else if (textured) {
             detail.texture = make_texture(texture, material.kd, k2, texture_scale);
         }
         detail.bump = bump;
-        if (height) detail.height_map = std::make_shared<const HeightMap>(height, bump_strength);
+        if (height)
+            detail.height_map = std::make_shared<const HeightMap>(height, bump_strength, filter);
         detail.texture_scale = texture_scale;
         detail.corner_uv = corner_uv;
         return detail;
@@ -330,6 +332,15 @@ SurfaceSpec read_surface(Attributes& in) {
         in.find("TextureFile");  // known, unused while the image texture is off
     }
     s.bump_file = in.text("BumpFile", "");
+    const std::string filter = in.text("TextureFilter", "anisotropic");
+    if (filter == "trilinear") {
+        s.filter = TextureFilter::kTrilinear;
+    } else if (filter == "bilinear") {
+        s.filter = TextureFilter::kBilinear;
+    } else if (filter != "anisotropic") {
+        in.fail("TextureFilter must be anisotropic, trilinear or bilinear, got \"" +
+                abbreviated(filter) + "\"");
+    }
 
     const bool bumped = in.flag("bumpEnable", false);
     BumpMap bump;

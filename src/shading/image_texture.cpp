@@ -8,7 +8,12 @@ namespace drt {
 namespace {
 
 double length2(Vec2 v) {
-    return std::sqrt(v.x * v.x + v.y * v.y);
+    return std::hypot(v.x, v.y);
+}
+
+// A height map reads one trilinear square per lookup, as its central differences take four.
+Color read(const MipMap& image, TextureFilter filter, Vec2 uv, double width) {
+    return filter == TextureFilter::kBilinear ? image.bilinear(0, uv) : image.filtered(uv, width);
 }
 
 }  // namespace
@@ -18,17 +23,25 @@ double footprint_width(const TexturePoint& at) {
 }
 
 Color ImageTexture::value(const TexturePoint& at) const {
-    return image_->filtered(at.uv, footprint_width(at));
+    switch (filter_) {
+        case TextureFilter::kAnisotropic:
+            return image_->filtered(at.uv, at.duv_dx, at.duv_dy);
+        case TextureFilter::kTrilinear:
+            return image_->filtered(at.uv, footprint_width(at));
+        case TextureFilter::kBilinear:
+            break;
+    }
+    return image_->bilinear(0, at.uv);
 }
 
 double HeightMap::height(const TexturePoint& at, Vec2 uv) const {
-    return luminance(image_->filtered(uv, footprint_width(at)));
+    return luminance(read(*image_, filter_, uv, footprint_width(at)));
 }
 
 Vec3 HeightMap::perturb(const Vec3& normal, const TexturePoint& at, const Vec3& dp_du,
                         const Vec3& dp_dv) const {
     // Central differences one texel (or one footprint, if wider) either side.
-    const double width = footprint_width(at);
+    const double width = filter_ == TextureFilter::kBilinear ? 0 : footprint_width(at);
     const double du = std::max(1.0 / image_->width(), width);
     const double dv = std::max(1.0 / image_->height(), width);
     const Vec2 uv = at.uv;

@@ -115,4 +115,21 @@ Color MipMap::filtered(Vec2 uv, double width) const {
     return bilinear(below, uv) * (1 - t) + bilinear(below + 1, uv) * t;
 }
 
+Color MipMap::filtered(Vec2 uv, Vec2 dx, Vec2 dy) const {
+    const double lx = std::hypot(dx.x, dx.y), ly = std::hypot(dy.x, dy.y);
+    const Vec2 major = lx >= ly ? dx : dy;
+    const double major_length = std::max(lx, ly);
+    const double minor_length = std::max(std::min(lx, ly), major_length / kMaxAnisotropy);
+    if (!(minor_length > 0)) return bilinear(0, uv);
+    const int probes =
+        std::min(kMaxAnisotropy, static_cast<int>(std::ceil(major_length / minor_length)));
+    if (probes <= 1) return filtered(uv, major_length);
+    Color sum;
+    for (int k = 0; k < probes; ++k) {
+        const double t = (k + 0.5) / probes - 0.5;
+        sum += filtered({uv.x + major.x * t, uv.y + major.y * t}, minor_length);
+    }
+    return sum * (1.0 / probes);
+}
+
 }  // namespace drt

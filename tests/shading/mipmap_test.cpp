@@ -98,5 +98,22 @@ TEST(MipMap, TrilinearPicksTheLevelOfTheFootprint) {
     EXPECT_NEAR(map.filtered({0.125, 0.125}, std::pow(2.0, -1.5)).r, 0.5 * (texel00 + 0.5), 1e-6);
 }
 
+// Horizontal stripes (rows alternate black and white) seen with a footprint long along u and
+// one texel high: anisotropic probes along u keep the stripe, one trilinear square as wide as
+// the long side blurs it to grey.
+TEST(MipMap, AnisotropicProbesBlurAlongTheLongSideOnly) {
+    Image stripes(8, 8);
+    for (int j = 0; j < 8; ++j)
+        for (int i = 0; i < 8; ++i) stripes.set(i, j, Color{double(j % 2), 0, 0});
+    const MipMap map(stripes);
+    const Vec2 bottom_row{0.3, 1.0 / 16};  // the centre of texel row 0 from the bottom: white
+    EXPECT_NEAR(map.filtered(bottom_row, {0.5, 0}, {0, 1.0 / 8}).r, 1, 1e-6);
+    EXPECT_NEAR(map.filtered(bottom_row, 0.5).r, 0.5, 1e-6);
+    // A square footprint is the trilinear one.
+    EXPECT_EQ(map.filtered(bottom_row, {0.25, 0}, {0, 0.25}).r, map.filtered(bottom_row, 0.25).r);
+    // A footprint of zero reads level 0.
+    EXPECT_EQ(map.filtered({0.4, 0.3}, {}, {}).r, map.bilinear(0, {0.4, 0.3}).r);
+}
+
 }  // namespace
 }  // namespace drt

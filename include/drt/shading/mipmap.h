@@ -1,6 +1,7 @@
 // An image prepared for filtered lookups at texture coordinates: a pyramid of box-filtered
 // levels, each half the size of the one before, read bilinearly and blended between the two
-// levels around a footprint's width (trilinear filtering, Williams 1983).
+// levels around a footprint's width (trilinear filtering, Williams 1983), several times along
+// a long footprint (anisotropic filtering).
 #pragma once
 
 #include <cstdint>
@@ -34,6 +35,12 @@ class MipMap {
     // Trilinear: the footprint's `width` in texture coordinates (the larger side of the area one
     // sample stands for) picks the level whose texels are that wide; 0 reads level 0.
     Color filtered(Vec2 uv, double width) const;
+    // Anisotropic: a footprint spanned by the steps `dx` and `dy` is read as up to
+    // kMaxAnisotropy trilinear probes of the shorter step's width, spread evenly along the
+    // longer step (as graphics hardware does), so that a surface seen at a grazing angle is
+    // blurred along the view only, not across it too.
+    Color filtered(Vec2 uv, Vec2 dx, Vec2 dy) const;
+    static constexpr int kMaxAnisotropy = 16;
 
   private:
     struct Level {
