@@ -27,7 +27,7 @@ constexpr Vec2 kLightCentre{0, 0};
 // read the finest level.
 SurfaceHit surface_of(const Ray& ray, const Hit& hit, int depth, const Camera& camera,
                       int samples) {
-    if (depth > 0 || !hit.object->detail().reads_uv()) return hit.object->surface_at(ray, hit);
+    if (depth > 0 || !hit.object->reads_uv()) return hit.object->surface_at(ray, hit);
     const double step = std::max(0.125, 1 / std::sqrt(std::max(samples, 1)));
     const RayDifferential differential = camera.differential(ray, step);
     return hit.object->surface_at(ray, hit, &differential);

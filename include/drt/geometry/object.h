@@ -97,7 +97,7 @@ struct SurfaceUv {
 class Object {
   public:
     Object(const Material& material, SurfaceDetail detail)
-        : material_(&material), detail_(std::move(detail)) {}
+        : material_(&material), detail_(std::move(detail)), reads_uv_(detail_.reads_uv()) {}
     virtual ~Object() = default;
     Object(const Object&) = delete;
     Object& operator=(const Object&) = delete;
@@ -109,6 +109,8 @@ class Object {
 
     const Material& material() const { return *material_; }
     const SurfaceDetail& detail() const { return detail_; }
+    // Whether the surface's texture or height map reads (u, v): detail().reads_uv(), kept.
+    bool reads_uv() const { return reads_uv_; }
     // Shutter time at which the object's motion path ends; 0 for an object that stays put.
     virtual double motion_end() const { return 0; }
     bool moves() const { return motion_end() > 0; }
@@ -137,6 +139,7 @@ class Object {
   private:
     const Material* material_;
     SurfaceDetail detail_;
+    bool reads_uv_;
 };
 
 }  // namespace drt
