@@ -134,8 +134,10 @@ TEST(TextureFile, HostileSizeIsRefusedFromTheHeader) {
 // Files cut short are an error, never pixels made up from missing bytes.
 TEST(TextureFile, TruncatedFilesAreErrors) {
     const unsigned char grey[3 * 64 * 64] = {};
-    for (const std::string kind : {"png", "bmp", "tga", "jpg", "hdr"}) {
+    for (const std::string kind : {"png", "bmp", "tga", "tga-rle", "jpg", "hdr"}) {
         Bytes full;
+        stbi_write_tga_with_rle = kind == "tga-rle" ? 1 : 0;
+        if (kind == "tga-rle") stbi_write_tga_to_func(append, &full, 64, 64, 3, grey);
         if (kind == "png") stbi_write_png_to_func(append, &full, 64, 64, 3, grey, 3 * 64);
         if (kind == "bmp") stbi_write_bmp_to_func(append, &full, 64, 64, 3, grey);
         if (kind == "tga") stbi_write_tga_to_func(append, &full, 64, 64, 3, grey);
