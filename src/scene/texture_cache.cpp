@@ -2,7 +2,6 @@
 
 #include <system_error>
 
-#include "drt/util/limits.h"
 #include "drt/util/text.h"
 
 namespace drt {
@@ -17,12 +16,15 @@ std::shared_ptr<const MipMap> TextureCache::get(const std::filesystem::path& pat
     if (found != cache_.end()) return found->second;
     const Image image = read_texture(path, encoding);
     const std::uint64_t bytes = MipMap::bytes_for(image.width, image.height);
-    if (bytes > kMaxTextureBytes - bytes_) {
+    if (bytes > budget_ - bytes_) {
+        const auto amount = [](std::uint64_t b) {
+            return b >= (1u << 20) ? std::to_string(b >> 20) + " MiB"
+                                   : std::to_string(b) + " bytes";
+        };
         throw ImageError(printable(path.string()) + ": textures would take " +
-                         std::to_string((bytes_ + bytes) >> 20) + " MiB with this image of " +
+                         amount(bytes_ + bytes) + " with this image of " +
                          std::to_string(image.width) + "x" + std::to_string(image.height) +
-                         ", past the " + std::to_string(kMaxTextureBytes >> 20) +
-                         " MiB texture memory budget");
+                         ", past the texture memory budget of " + amount(budget_));
     }
     bytes_ += bytes;
     auto mipmap = std::make_shared<const MipMap>(image);

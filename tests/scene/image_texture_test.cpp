@@ -11,6 +11,7 @@
 #include "drt/geometry/plane.h"
 #include "drt/scene/camera.h"
 #include "drt/scene/scene_loader.h"
+#include "drt/scene/texture_cache.h"
 #include "run_drt.h"
 #include "temp_folder.h"
 
@@ -156,6 +157,29 @@ TEST_F(ImageTextureScene, EachFileIsReadOnce) {
                          "\"t.png\" " + "BumpFile=\"t.png\"/>"));
     // Once as colour, once as data for the height map.
     EXPECT_EQ(loaded.files_read.size(), 2u);
+}
+
+// A 2 x 2 image's mip-map takes 12 bytes × (4 + 1) texels = 60: two different files fit in 120
+// bytes, a third is refused, the same file again costs nothing.
+TEST_F(ImageTextureScene, TexturesStayWithinTheMemoryBudget) {
+    write_two_by_two("a.png");
+    write_two_by_two("b.png");
+    write_two_by_two("c.png");
+    TextureCache cache(120);
+    const auto a = cache.get(dir_ / "a.png", TextureEncoding::kColor);
+    cache.get(dir_ / "b.png", TextureEncoding::kColor);
+    EXPECT_EQ(cache.bytes(), 120u);
+    EXPECT_EQ(cache.get(dir_ / "a.png", TextureEncoding::kColor), a);
+    try {
+        cache.get(dir_ / "c.png", TextureEncoding::kColor);
+        ADD_FAILURE() << "no error past the budget";
+    } catch (const ImageError& e) {
+        EXPECT_NE(std::string(e.what()).find("c.png: textures would take 180 bytes with this image "
+                                             "of 2x2, past the texture memory budget of 120 bytes"),
+                  std::string::npos)
+            << e.what();
+    }
+    EXPECT_EQ(cache.files_read(), 2u);
 }
 
 TEST_F(ImageTextureScene, MissingCorruptAndHostileImagesAreErrorsAtTheirLine) {
