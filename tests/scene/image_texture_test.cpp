@@ -9,6 +9,7 @@
 
 #include "drt/accel/mesh.h"
 #include "drt/geometry/plane.h"
+#include "drt/io/image.h"
 #include "drt/scene/camera.h"
 #include "drt/scene/scene_loader.h"
 #include "drt/scene/texture_cache.h"
@@ -212,6 +213,52 @@ TEST_F(ImageTextureScene, MissingCorruptAndHostileImagesAreErrorsAtTheirLine) {
     EXPECT_NE(load_error("<Mesh File=\"m.obj\" Material=\"M\" BumpFile=\"t.png\"/>")
                   .find("not supported yet"),
               std::string::npos);
+}
+
+// A rendered check of the whole path: a wall (normal +z) seen from +z through one copy of an
+// 8 x 8 image of four coloured quadrants, 2 x 2 pixels. e_u = +x, e_v = +y, and seen from +z
+// the image's +u runs to the screen's left: the top-left pixel shows the top-right quadrant.
+TEST_F(ImageTextureScene, RenderShowsTheContractsOrientation) {
+    unsigned char rgb[8 * 8 * 3];
+    for (int y = 0; y < 8; ++y) {
+        for (int x = 0; x < 8; ++x) {
+            // Rows from the top: red | green over blue | white.
+            const bool top = y < 4, left = x < 4;
+            const unsigned char r = top == left ? 255 : 0;
+            const unsigned char g = top && !left ? 255 : (!top && !left ? 255 : 0);
+            const unsigned char b = !top ? 255 : 0;
+            unsigned char* p = rgb + 3 * (y * 8 + x);
+            p[0] = r, p[1] = g, p[2] = b;
+        }
+    }
+    ASSERT_TRUE(stbi_write_png((dir_ / "q.png").c_str(), 8, 8, 3, rgb, 24));
+    test::write_bytes(dir_ / "wall.xml",
+                      "<Scene><Image Width=\"2\" Height=\"2\"/><Render Samples=\"16\"/>"
+                      "<Ambient r=\"1\" g=\"1\" b=\"1\"/>"
+                      "<Camera Ex=\"10\" Ey=\"10\" Ez=\"10\" Lx=\"10\" Ly=\"10\" Lz=\"0\" "
+                      "Fov=\"90\"/>"
+                      "<Materials><M kdr=\"1\" kdg=\"1\" kdb=\"1\" diffuse=\"1\"/></Materials>"
+                      "<Plane Px=\"0\" Py=\"0\" Pz=\"0\" Vu=\"0\" Vv=\"0\" Vw=\"1\" Material=\"M\" "
+                      "EnableTexture=\"1\" Texture=\"image\" TextureFile=\"q.png\" "
+                      "TextureScale=\"20\"/></Scene>");
+    const test::Outcome r = test::run_drt({"wall.xml", "-q", "-o", "wall.pfm"}, dir_);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const Image image = read_image(dir_ / "wall.pfm");
+    const Color top_left = image.at(0, 0), top_right = image.at(1, 0);
+    const Color bottom_left = image.at(0, 1), bottom_right = image.at(1, 1);
+    // Each pixel is mostly its quadrant's colour; bilinear lookups within a texel of the
+    // quadrants' borders blend in a little of the neighbours.
+    EXPECT_GT(top_left.g, 0.8);  // green: u in [½, 1], v in [½, 1]
+    EXPECT_LT(top_left.r, 0.2);
+    EXPECT_LT(top_left.b, 0.2);
+    EXPECT_GT(top_right.r, 0.8);  // red: u in [0, ½]
+    EXPECT_LT(top_right.g, 0.2);
+    EXPECT_GT(bottom_left.r, 0.8);  // white
+    EXPECT_GT(bottom_left.g, 0.8);
+    EXPECT_GT(bottom_left.b, 0.8);
+    EXPECT_GT(bottom_right.b, 0.8);  // blue
+    EXPECT_LT(bottom_right.r, 0.2);
+    EXPECT_LT(bottom_right.g, 0.2);
 }
 
 TEST_F(ImageTextureScene, TheCommandLineExitsWithStatusTwo) {
