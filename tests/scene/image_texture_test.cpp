@@ -158,6 +158,11 @@ TEST_F(ImageTextureScene, EachFileIsReadOnce) {
                          "\"t.png\" " + "BumpFile=\"t.png\"/>"));
     // Once as colour, once as data for the height map.
     EXPECT_EQ(loaded.files_read.size(), 2u);
+    // BumpFile bumps by the image without bumpEnable, and instead of Perlin noise.
+    const SurfaceDetail& bumped = loaded.scene.objects.at(2)->detail();
+    EXPECT_NE(bumped.height_map, nullptr);
+    EXPECT_FALSE(bumped.bump);
+    EXPECT_EQ(loaded.scene.objects.at(0)->detail().height_map, nullptr);
 }
 
 // A 2 x 2 image's mip-map takes 12 bytes × (4 + 1) texels = 60: two different files fit in 120

@@ -115,5 +115,25 @@ TEST(MipMap, AnisotropicProbesBlurAlongTheLongSideOnly) {
     EXPECT_EQ(map.filtered({0.4, 0.3}, {}, {}).r, map.bilinear(0, {0.4, 0.3}).r);
 }
 
+// A height ramp h = (i + ½)/8 over 8 texels along u rises by 1 per unit of u: strength ½ tilts
+// the normal (0, 0, 1) against the slope to normalize(−½, 0, 1), whatever the scale of ∂p/∂u
+// (only its direction counts); a flat v leaves y alone.
+TEST(HeightMap, TiltsTheNormalAgainstTheSlopeTimesStrength) {
+    Image ramp(8, 1);
+    for (int i = 0; i < 8; ++i) ramp.set(i, 0, Color{1, 1, 1} * ((i + 0.5) / 8));
+    const HeightMap bumps(std::make_shared<const MipMap>(ramp), 0.5);
+    TexturePoint at;
+    at.uv = {0.5, 0.5};
+    const Vec3 n = bumps.perturb({0, 0, 1}, at, {3, 0, 0}, {0, 2, 0});
+    const Vec3 expected = normalize(Vec3{-0.5, 0, 1});
+    EXPECT_NEAR(n.x, expected.x, 1e-6);
+    EXPECT_NEAR(n.y, 0, 1e-12);
+    EXPECT_NEAR(n.z, expected.z, 1e-6);
+    // The tangent direction carries the tilt: u growing along −y tilts towards +y.
+    const Vec3 turned = bumps.perturb({0, 0, 1}, at, {0, -1, 0}, {1, 0, 0});
+    EXPECT_NEAR(turned.y, -expected.x, 1e-6);
+    EXPECT_NEAR(turned.x, 0, 1e-12);
+}
+
 }  // namespace
 }  // namespace drt
