@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "drt/accel/mesh.h"
+#include "drt/accel/triangle_mesh.h"
 #include "drt/geometry/plane.h"
 #include "drt/geometry/sphere.h"
 #include "drt/util/float_rounding.h"
