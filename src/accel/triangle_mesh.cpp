@@ -8,6 +8,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "drt/geometry/collinear.h"
 #include "drt/util/huge_pages.h"
 #include "drt/util/limits.h"
 
@@ -84,10 +85,15 @@ void TriangleMesh::take(const ObjMesh& obj, const MeshTransform& transform, bool
     triangles_.reserve(corners / 3);
     for (std::size_t c = 0; c < corners; c += 3) {
         const std::uint32_t* p = &obj.position_indices[c];
+        // Zero area is the file's: rounding to float may move its corners off their line.
+        if (collinear(obj.positions[p[0]], obj.positions[p[1]], obj.positions[p[2]])) {
+            ++dropped_;
+            continue;
+        }
         const Vec3 a = to_vec3(local_positions[p[0]]), b = to_vec3(local_positions[p[1]]),
                    d = to_vec3(local_positions[p[2]]);
         if (cross(b - a, d - a) == Vec3{}) {
-            ++dropped_;
+            ++collapsed_;
             continue;
         }
         const std::uint32_t* n = &obj.normal_indices[c];

@@ -24,12 +24,13 @@ namespace drt {
 
 class TriangleMesh {
   public:
-    // Transforms the file's vertices and builds the hierarchy. Triangles of zero area are left
-    // out (dropped() counts them). With `smooth`, vertex normals are the file's `vn` where a
-    // corner has one, else the angle-weighted normals of the faces around the vertex. Throws
-    // std::domain_error if a transformed coordinate does not fit in single precision. The
-    // hierarchy is built on `build_threads` threads (0: one per core); the tree is the same
-    // whatever their number.
+    // Transforms the file's vertices and builds the hierarchy. Triangles of zero area in the
+    // file's own coordinates are left out (dropped() counts them), and so are those that
+    // single precision flattens (collapsed() counts them). With `smooth`, vertex normals are the
+    // file's `vn` where a corner has one, else the angle-weighted normals of the faces around the
+    // vertex. Throws std::domain_error if a transformed coordinate does not fit in single
+    // precision. The hierarchy is built on `build_threads` threads (0: one per core); the tree is
+    // the same whatever their number.
     TriangleMesh(const ObjMesh& obj, const MeshTransform& transform, bool smooth,
                  int build_threads = 0);
     // The same, emptying `obj` before the hierarchy is built, which lowers the peak memory.
@@ -37,6 +38,9 @@ class TriangleMesh {
 
     std::size_t triangle_count() const { return triangles_.size(); }
     std::size_t dropped() const { return dropped_; }
+    // Triangles of non-zero area whose corners, in single precision, lie on a line: no ray
+    // meets them at a well-defined point and they have no normal to shade with.
+    std::size_t collapsed() const { return collapsed_; }
     // Where the mesh's own coordinates have their origin, in the coordinates of the transform.
     const Vec3& origin() const { return origin_; }
     // Bounds in the mesh's own coordinates.
@@ -96,6 +100,7 @@ class TriangleMesh {
     std::vector<std::array<std::uint32_t, 3>> triangles_;  // in leaf order
     MeshTree tree_;
     std::size_t dropped_ = 0;
+    std::size_t collapsed_ = 0;
 };
 
 // The ray moved into a mesh's own coordinates, whose origin is at `origin`: the BVH and
