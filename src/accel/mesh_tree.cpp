@@ -277,8 +277,8 @@ MeshTree::Answer<kAnyHit> MeshTree::traverse(const Ray& ray, Interval range, Mes
     const float certain_low = range.min > 0 ? to_float_up(range.min) : 0;
     const float certain_high = to_float_down(range.max);
     // The nearest hit so far (kept by a nearest-hit query only), made into the answer only on
-    // return: an optional built up field by field and copied out at the end stalled every ray
-    // on store forwarding, 8 % of a query.
+    // return: an optional built up field by field and copied out at the end stalls every ray
+    // on store forwarding.
     struct Nearest {
         std::uint32_t triangle = std::numeric_limits<std::uint32_t>::max();  // none yet
         double t = 0;
@@ -310,8 +310,7 @@ MeshTree::Answer<kAnyHit> MeshTree::traverse(const Ray& ray, Interval range, Mes
                 int maybe = (1 << lanes) - 1;
                 if constexpr (kAnyHit) {
                     // A triangle the filter proves the double test would hit answers the
-                    // query without that test (the double test was 9 % of a shadow ray's time
-                    // on average, run once for each blocked ray).
+                    // query without that test, which every blocked ray would otherwise run.
                     if (use_filter) {
                         const auto verdict = filter.classify(gather(first, lanes), filter_near, far,
                                                              certain_low, certain_high);
@@ -357,10 +356,9 @@ MeshTree::Answer<kAnyHit> MeshTree::traverse(const Ray& ray, Interval range, Mes
                 continue;
             }
             if (mask != 0) {
-                // The children met, nearest first; among equal entries the last child first,
-                // the order in which earlier versions visited them. One child or two (the
-                // later one first on a tie) in the same order without the general sort:
-                // camera rays 4 % faster.
+                // The children met, nearest first; among equal entries the last child first:
+                // the order decides which of two hits at the same t is kept, so it is fixed.
+                // One child or two, the common case, in that order without the general sort.
                 int c = std::countr_zero(static_cast<unsigned>(mask));
                 const int rest = mask & (mask - 1);
                 if (rest != 0 && (rest & (rest - 1)) == 0) {
@@ -384,8 +382,8 @@ MeshTree::Answer<kAnyHit> MeshTree::traverse(const Ray& ray, Interval range, Mes
                     c = order[0];
                 }
                 current = {node.child[c], node.count[c], entry[c]};
-                // The nearest child's other cache lines are fetched while its first is tested
-                // (on a mesh of a million triangles most nodes come from memory).
+                // The nearest child's other cache lines are fetched while its first is tested:
+                // on a large mesh most nodes come from memory.
                 if (current.count == 0) {
                     const auto* next = reinterpret_cast<const char*>(&nodes_[current.child]);
                     _mm_prefetch(next + 64, _MM_HINT_T0);

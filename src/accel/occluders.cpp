@@ -13,11 +13,8 @@ constexpr double kSlack = 1e-9;
 // of it: far above rounding, and far below the offset a spawned ray starts at
 // (spawn_ray: |p| · 2⁻³² ≈ 2.3e-10 |p|), so an origin spawned off a plane is on its side.
 constexpr double kOffPlane = 1e-12;
-// Fewer shadow rays than this to a light from a point are traced through the tree as they are.
-// Measured (Test1 at a quarter size, one thread, user seconds, medians of five alternating runs;
-// docs/performance.md, fifth round): with one ray per light, culling and not culling take the
-// same time (1.85 s against 1.86 s); with two, culling is 7 % faster (1.63 s against 1.75 s; Test4
-// 8 %); with three, 20 % (1.72 s against 2.06 s).
+// Fewer shadow rays than this to a light from a point are traced through the tree as they are:
+// for a single ray, gathering the occluders costs what it saves; from two on, culling wins.
 constexpr int kMinRaysToCull = 2;
 
 // The cone of segments from an apex to the points of a ball, and whether a ball may meet one.

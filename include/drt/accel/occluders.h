@@ -19,10 +19,9 @@ class Occluders {
     // (a room has six), a word is set and walked without branches, and planes past the 64th
     // are simply always tested (correct, only slower).
     static constexpr std::size_t kPlaneBits = 64;
-    // Primitives listed at most; more, and the rays traverse the tree instead. Measured with
-    // 4, 16 and 64 on scenes of 100 and 1000 spheres: 4 is 6 % slower at 1000, 64 no faster
-    // than 16 (docs/performance.md, sixth round). A fixed array keeps the culling on the stack
-    // (no allocation per shading point).
+    // Primitives listed at most; more, and the rays traverse the tree instead: fewer falls back
+    // to the tree too often, more lists what the tree would skip as cheaply. A fixed array keeps
+    // the culling on the stack (no allocation per shading point).
     static constexpr int kMaxListed = 16;
 
     // What a ray to the light must be tested against.
