@@ -139,15 +139,6 @@ void TriangleMesh::take(const ObjMesh& obj, const MeshTransform& transform, bool
     }
 }
 
-Vec3 TriangleMesh::position(std::uint32_t vertex) const {
-    return to_vec3(positions_[vertex]);
-}
-
-std::array<Vec3, 3> TriangleMesh::corners(std::uint32_t triangle) const {
-    const auto& t = triangles_[triangle];
-    return {position(t[0]), position(t[1]), position(t[2])};
-}
-
 Vec3 TriangleMesh::geometric_normal(std::uint32_t triangle) const {
     const auto [a, b, c] = corners(triangle);
     const Vec3 n = cross(b - a, c - a);

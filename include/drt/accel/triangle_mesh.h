@@ -1,8 +1,8 @@
 // A triangle mesh as drt stores and intersects it: vertex positions in single precision relative
 // to the mesh's own origin (the centre of its bounds), one index buffer, vertex normals for
-// smooth shading, and a tree of its own over its triangles (mesh_tree.h). A scene places the
-// mesh by translating that origin (and moves it by moving the translation), so a mesh keeps its
-// single-precision detail however far from the world's origin it stands.
+// smooth shading, and a tree of its own over its triangles (mesh_tree.h, mesh_traversal.cpp). A
+// scene places the mesh by translating that origin (and moves it by moving the translation), so a
+// mesh keeps its single-precision detail however far from the world's origin it stands.
 #pragma once
 
 #include <array>
@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include "drt/accel/float3.h"
@@ -21,6 +22,12 @@
 #include "drt/util/ray.h"
 
 namespace drt {
+
+struct MeshHit {
+    double t;
+    std::uint32_t triangle;
+    Barycentrics b;
+};
 
 class TriangleMesh {
   public:
@@ -47,21 +54,18 @@ class TriangleMesh {
     Bounds bounds() const { return tree_.bounds(); }
 
     // Nearest hit inside `range` of a ray given in the mesh's own coordinates.
-    std::optional<MeshHit> intersect(const Ray& ray, Interval range) const {
-        return tree_.intersect(ray, range, geometry());
-    }
+    std::optional<MeshHit> intersect(const Ray& ray, Interval range) const;
     // Whether any triangle meets the ray inside `range` (stops at the first).
-    bool occluded(const Ray& ray, Interval range) const {
-        return tree_.occluded(ray, range, geometry());
-    }
+    bool occluded(const Ray& ray, Interval range) const;
     // How many triangles the query (nearest hit, or any hit) tests on its way, counting every
     // triangle of a batch of up to four tested together: what the hierarchy saves, for tests
     // and benchmarks.
-    std::uint64_t triangle_tests(const Ray& ray, Interval range, bool any_hit) const {
-        return tree_.triangle_tests(ray, range, geometry(), any_hit);
-    }
+    std::uint64_t triangle_tests(const Ray& ray, Interval range, bool any_hit) const;
 
-    std::array<Vec3, 3> corners(std::uint32_t triangle) const;
+    std::array<Vec3, 3> corners(std::uint32_t triangle) const {
+        const auto& t = triangles_[triangle];
+        return {position(t[0]), position(t[1]), position(t[2])};
+    }
     // Unit (p1 - p0) × (p2 - p0): outward for a closed mesh wound counter-clockwise.
     Vec3 geometric_normal(std::uint32_t triangle) const;
     // Unit interpolated vertex normal, or the geometric normal for a flat mesh; may face either
@@ -86,13 +90,18 @@ class TriangleMesh {
   private:
     // The vertices, triangles and normals of the mesh from the file's.
     void take(const ObjMesh& obj, const MeshTransform& transform, bool smooth);
-    Vec3 position(std::uint32_t vertex) const;
+    Vec3 position(std::uint32_t vertex) const { return to_vec3(positions_[vertex]); }
     // `threads` 0: one per core.
     void build_hierarchy(int threads);
     // Numbers the vertices in the order the leaves first use them, so that a leaf's corners
     // are near each other in memory.
     void order_vertices_by_leaves();
-    MeshGeometry geometry() const { return {positions_, triangles_}; }
+    // What a query answers: whether any triangle is hit, or the nearest hit.
+    template <bool kAnyHit>
+    using Answer = std::conditional_t<kAnyHit, bool, std::optional<MeshHit>>;
+    // The query (mesh_traversal.cpp); `tests`, when given, counts the triangles tested.
+    template <bool kAnyHit>
+    Answer<kAnyHit> traverse(const Ray& ray, Interval range, std::uint64_t* tests = nullptr) const;
 
     Vec3 origin_;
     std::vector<Float3> positions_;  // relative to origin_
