@@ -82,9 +82,9 @@ bool zero_area_exactly(double ua, double va, double ub, double vb, double uc, do
     return positive == negative;
 }
 
-// The same for the plane's points a, b, c; first in double, which settles all but (nearly)
-// collinear points: the computed value's error is below 3 ulps of |left| + |right| (Shewchuk
-// 1997, orient2d) and a smallest subnormal or two from underflow, far below `bound`.
+// The same, first in double, which settles all but (nearly) collinear points: the computed
+// value is off by at most about 3u (|left| + |right|), u = 2^-53 (Shewchuk 1997, orient2d), plus
+// a few smallest subnormals where a product underflows; `bound` is well above both.
 bool zero_area(double ua, double va, double ub, double vb, double uc, double vc) {
     const double left = (ua - uc) * (vb - vc), right = (va - vc) * (ub - uc);
     const double bound =
