@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
+
+#include "drt/util/rng.h"
 
 namespace drt {
 namespace {
@@ -71,6 +74,39 @@ TEST(Collinear, ALineSpanningTheWholeRangeOfExponents) {
     const Vec3 a{1e15, 1e15, 1e15}, c{3e15, 3e15, 3e15};
     EXPECT_TRUE(collinear(a, {2e15, 2e15, 2e15}, c));
     EXPECT_FALSE(collinear(a, {2e15, 2e15, 2e15 + 0.25}, c));
+}
+
+// Points of small whole coordinates on a line, each axis then scaled by its own power of two
+// anywhere from the subnormals to near overflow (which keeps them on their line, exactly): all
+// collinear; the last corner moved by one ulp off the line: none.
+TEST(Collinear, LinesScaledPerAxisAcrossTheWholeExponentRange) {
+    int moved_off = 0;
+    for (std::uint64_t i = 0; i < 3000; ++i) {
+        const auto whole = [&](int k) {
+            return static_cast<double>(static_cast<int>(hash_of(21, i, k) % 41) - 20);
+        };
+        const auto exponent = [&](int k) {
+            return static_cast<int>(hash_of(22, i, k) % 2060) - 1060;
+        };
+        const Vec3 p{whole(0), whole(1), whole(2)}, d{whole(3), whole(4), whole(5)};
+        const double t = static_cast<double>(hash_of(23, i, 0) % 7) - 3;
+        const Vec3 q = p + d, r = p + d * t;
+        const int ex = exponent(0), ey = exponent(1), ez = exponent(2);
+        const auto scaled = [&](const Vec3& v) {
+            return Vec3{std::ldexp(v.x, ex), std::ldexp(v.y, ey), std::ldexp(v.z, ez)};
+        };
+        const Vec3 a = scaled(p), b = scaled(q), c = scaled(r);
+        ASSERT_TRUE(collinear(a, b, c)) << i;
+        // Off the line unless the line runs along y (then moving y keeps it there) or the
+        // corners coincide.
+        const Vec3 off{c.x, std::nextafter(c.y, 1e300), c.z};
+        const bool along_y = d.x == 0 && d.z == 0;
+        if (!along_y) {
+            EXPECT_FALSE(collinear(a, b, off)) << i;
+            ++moved_off;
+        }
+    }
+    EXPECT_GT(moved_off, 2900);
 }
 
 }  // namespace
