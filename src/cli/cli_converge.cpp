@@ -123,7 +123,7 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
                 << std::flush;
             RenderOptions plain = options;
             plain.adaptive.reset();
-            RenderResult r = render_with(scene, spp, seed, plain);
+            RenderResult r = render(scene, request_at(spp, seed, plain), plain);
             out << " " << std::fixed << std::setprecision(2) << r.stats.seconds << " s\n"
                 << std::defaultfloat;
             if (!save_reference.empty()) write_image(r.image, save_reference);

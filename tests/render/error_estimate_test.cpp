@@ -311,15 +311,16 @@ TEST(EstimateError, SameForAnyThreadsAndTileOrder) {
         one.threads = 1;
         const RenderResult a = render(scene, one);
         // Two threads, the tiles backwards.
-        const RenderContext context(scene, std::nullopt);
+        const RenderContext context(scene);
+        const RenderRequest request = RenderRequest::whole_image(scene.settings);
         ImageSink sink(scene.settings.width, scene.settings.height, context.tiles());
         std::vector<Tile> backwards = context.tiles();
         std::reverse(backwards.begin(), backwards.end());
         TileQueue source(backwards);
         RenderOptions two;
         two.threads = 2;
-        render_tiles(context, source, sink, two);
-        const RenderResult b = assembled(context, sink);
+        render_tiles(context, request, source, sink, two);
+        const RenderResult b = assembled(context, request, sink);
         EXPECT_EQ(a.image.rgb, b.image.rgb);
         EXPECT_EQ(a.spread.rgb, b.spread.rgb) << sampler;
         ASSERT_TRUE(a.stats.error.available() && b.stats.error.available()) << sampler;

@@ -5,7 +5,7 @@
 // Each pixel keeps a spread per channel, a guess at the variance of its mean. For independent
 // samples (the random sampler) it is their sample variance over n (pixel_spread), which is that
 // variance. For a stratified or Sobol pattern the sample variance ignores the stratification and
-// overstated the error by 1.3 to 10x (docs/accuracy.md); their spread is the strata spread
+// overstates the error several times; their spread is the strata spread
 // (strata_spread), from differences of neighbouring strata, which credits the stratification but
 // cannot see correlations between strata. There the spread only says where the error is, and the
 // image calibrates how large it is: a few pixels of each tile, chosen at random with odds that
@@ -90,18 +90,26 @@ struct StrataScratch {
 // n is the variance of the mean if every stratum had that variance. A smooth gradient cancels,
 // unlike in the sample variance, which counts it whole and so overstated an edge's stratified
 // error about sqrt(n)-fold; an edge across a band counts about twice its variance, one along a
-// band once. The calibration then scales what is left (docs/accuracy.md). Infinite for fewer than
-// two samples.
+// band once. The calibration then scales what is left. Infinite for fewer than two samples.
 Color strata_spread(std::span<const Vec2> positions, std::span<const Color> samples,
                     StrataScratch& scratch);
 
+// For each pixel of a width x height image of `values` (row by row), the largest value among its
+// (up to) 8 neighbours, and with kWithSelf its own too: a pixel whose few samples all fell on one
+// side of an edge shows no spread, though its neighbours along the edge do.
+enum class Around { kWithSelf, kNeighboursOnly };
+std::vector<double> largest_around(std::span<const double> values, int width, int height,
+                                   Around which);
+
+// The odds of picking a pixel when `scale` picks go a quarter equally (`even`, each pixel's part
+// of that quarter as a share of the unit) and three quarters in proportion to the pixel's
+// `weight` out of `total`; at most 1. Every pixel keeps some odds, so sums weighted by 1 / odds
+// stay unbiased, and the pixels that carry most of the error are picked most often.
+double pick_odds(double scale, double even, double weight, double total);
+
 // For each pixel of a tile (its spread image, row by row), the odds of rendering it a second
-// time: `share` on average over the tile, a quarter of them shared equally and the rest in
-// proportion to the largest spread of the pixel and its (up to 8) neighbours in the tile, at
-// most 1. Pixels where the samples spread more carry most of the error, so the calibration looks
-// there most often; the neighbours count because a pixel of few samples can miss the edge that
-// crosses it (no spread, yet a large error) while its neighbours along the edge show it. Every
-// pixel keeps some odds, so the weighted sums stay unbiased.
+// time: `share` on average over the tile, by pick_odds with the largest spread (summed over
+// channels) of the pixel and its neighbours in the tile as the weight (largest_around).
 std::vector<double> calibration_odds(const Image& spread, double share);
 
 // Adds a pixel rendered twice: `first` the image's mean and `spread` its spread, `second` the
