@@ -42,7 +42,7 @@ struct MpiShare {
     int threads = 0;  // worker threads of this process
     // Leader only: when its queue handed out the last tile (the start of the render's tail), and
     // the finished tiles other processes sent, with the time its communication thread spent
-    // receiving them and adding them to the image (the per-message cost in docs/scale-out.md).
+    // receiving them and adding them to the image.
     std::optional<std::chrono::steady_clock::time_point> emptied;
     std::uint64_t messages = 0;
     double receive_seconds = 0, assemble_seconds = 0;

@@ -42,16 +42,13 @@ enum class SpreadKind { kIndependent, kCalibrated };
 inline constexpr double kCalibrationShare = 0.08;
 // A calibration of this many pixels pins the estimate's scale to a few per cent (the relative
 // spread of a variance from N independent differences is about sqrt(2 / N)); more would only
-// add cost, so a large image renders this many twice rather than kCalibrationShare of its
-// pixels (800 x 600: 0.9 % instead of 8 %).
+// add cost, so a large image renders this many twice rather than kCalibrationShare of its pixels.
 inline constexpr double kMaxCalibrationPixels = 4096;
 // Fewer pixels rendered twice than this leave the calibration too noisy to state a number.
 inline constexpr double kMinCalibrationPixels = 24;
-// A small image renders at least this many pixels twice (all of them below it). The
+// A small image renders at least this many pixels twice (all of them below it): the
 // calibration's noise depends on how many pixels it takes, not on their share, and a small
-// image's error sits in few pixels: at 48 x 36 (aa-10spp, stratified 256 spp, 10 seeds) the
-// estimate ranged over 0.74-1.41 of the true RMSE with 8 % (~140 pixels), 0.91-1.14 with 512
-// (docs/accuracy.md). It costs 30 % more samples there and nothing above 6,400 pixels.
+// image's error sits in few pixels.
 inline constexpr double kMinSmallImageCalibration = 512;
 // The share for an image of `pixels` pixels: kCalibrationShare, capped at kMaxCalibrationPixels
 // pixels, or more for a small image, so that kMinSmallImageCalibration pixels are rendered twice
@@ -135,7 +132,7 @@ struct ErrorEstimate {
 // variance (at least 0) for the unknown ref^2. `spp` is the samples per pixel asked for: with 1
 // the pixel centre is taken and nothing can be estimated. Where no sample of any pixel spread and
 // no pixel rendered twice differed, the estimate is 0 however few were rendered twice. `pixels`
-// is how many pixels were rendered, the others left 0 (a pilot's, render_context.h): the mean is
+// is how many pixels were rendered, the others left 0 (render_request.h): the mean is
 // theirs; 0 for all. Throws ImageError when the sizes differ.
 ErrorEstimate estimate_error(const Image& image, const Image& spread, const ErrorSums& sums,
                              std::uint64_t samples, int spp, SpreadKind kind,
