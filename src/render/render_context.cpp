@@ -221,7 +221,7 @@ TileBuffer RenderContext::render_tile(const Tile& tile, const RenderRequest& req
     return buffer;
 }
 
-std::uint64_t RenderContext::estimate_cost(const Tile& tile, const RenderRequest& request) const {
+std::uint64_t RenderContext::tile_cost(const Tile& tile, const RenderRequest& request) const {
     const int block = request.samples >= 16 ? 4 : 8;
     RayCounts rays;
     std::uint64_t probes = 0;
@@ -372,7 +372,7 @@ std::vector<Tile> costly_first(const RenderContext& context, const RenderRequest
     const auto most = static_cast<int>(std::min<std::size_t>(tiles.size(), INT_MAX));
     run_on_threads(std::min(threads, most), [&](const std::atomic<bool>& failed) {
         for (std::size_t i = next++; i < tiles.size() && !failed.load(); i = next++) {
-            costed[i] = {context.estimate_cost(tiles[i], request), tiles[i]};
+            costed[i] = {context.tile_cost(tiles[i], request), tiles[i]};
         }
     });
     std::stable_sort(costed.begin(), costed.end(),

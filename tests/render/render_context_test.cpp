@@ -22,25 +22,25 @@ Scene mirror_ball() {
     return testing::lone_sphere_scene(testing::mirror({0.5, 0.5, 0.5}), {0.1, 0.2, 0.3}, 96);
 }
 
-TEST(EstimateCost, CountsTheProbesShadedRaysScaledToTheTile) {
+TEST(TileCost, CountsTheProbesShadedRaysScaledToTheTile) {
     const Scene scene = mirror_ball();
     const RenderContext context(scene);
     const RenderRequest request = RenderRequest::whole_image(scene.settings);
     const std::vector<Tile>& tiles = context.tiles();
     ASSERT_EQ(tiles.size(), 36u);
-    EXPECT_EQ(context.estimate_cost(tiles[0], request), 256u);  // top left: background only
-    EXPECT_EQ(context.estimate_cost(tiles[35], request), 256u);
-    EXPECT_EQ(context.estimate_cost(tiles[14], request), 512u);  // beside the centre: all mirror
-    EXPECT_EQ(context.estimate_cost(tiles[21], request), 512u);
+    EXPECT_EQ(context.tile_cost(tiles[0], request), 256u);  // top left: background only
+    EXPECT_EQ(context.tile_cost(tiles[35], request), 256u);
+    EXPECT_EQ(context.tile_cost(tiles[14], request), 512u);  // beside the centre: all mirror
+    EXPECT_EQ(context.tile_cost(tiles[21], request), 512u);
     // An edge tile of 8 × 16 pixels, background only: half the cost.
     const Scene narrow =
         testing::lone_sphere_scene(testing::mirror({0.5, 0.5, 0.5}), {0.1, 0.2, 0.3}, 88);
     const RenderContext cut(narrow);
     EXPECT_EQ(cut.tiles()[5].width(), 8);
-    EXPECT_EQ(cut.estimate_cost(cut.tiles()[5], request), 128u);
+    EXPECT_EQ(cut.tile_cost(cut.tiles()[5], request), 128u);
 }
 
-TEST(EstimateCost, LeavesShadowRaysOut) {
+TEST(TileCost, LeavesShadowRaysOut) {
     // A grey ball lit through 8 shadow rays a shading point: the tiles on the ball trace 9 rays a
     // camera sample, those of the background 1, yet both count one shaded ray a pixel — a shading
     // point's own work, not its shadow rays, is what a tile's time follows (design.md).
@@ -52,8 +52,8 @@ TEST(EstimateCost, LeavesShadowRaysOut) {
     const RenderRequest request = RenderRequest::whole_image(scene.settings);
     const TileBuffer ball = context.render_tile(context.tiles()[14], request);
     ASSERT_EQ(ball.rays.shadow, 8u * ball.rays.camera);  // every pixel on the lit side
-    EXPECT_EQ(context.estimate_cost(context.tiles()[14], request), 256u);
-    EXPECT_EQ(context.estimate_cost(context.tiles()[0], request), 256u);
+    EXPECT_EQ(context.tile_cost(context.tiles()[14], request), 256u);
+    EXPECT_EQ(context.tile_cost(context.tiles()[0], request), 256u);
 }
 
 TEST(CostlyFirst, OrdersByFallingCostAndKeepsIndexOrderAmongEquals) {
@@ -66,8 +66,8 @@ TEST(CostlyFirst, OrdersByFallingCostAndKeepsIndexOrderAmongEquals) {
     EXPECT_EQ(order.front().index, 7u);  // the first of the all-mirror tiles
     EXPECT_EQ(order.back().index, 35u);  // the last of the background-only ones
     for (std::size_t i = 1; i < order.size(); ++i) {
-        const auto before = context.estimate_cost(order[i - 1], request);
-        const auto after = context.estimate_cost(order[i], request);
+        const auto before = context.tile_cost(order[i - 1], request);
+        const auto after = context.tile_cost(order[i], request);
         EXPECT_GE(before, after) << i;
         if (before == after) {
             EXPECT_LT(order[i - 1].index, order[i].index) << i;

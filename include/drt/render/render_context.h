@@ -53,13 +53,13 @@ class RenderContext {
     // Renders the pixels of `tile` that `request` picks. Safe to call from several threads.
     TileBuffer render_tile(const Tile& tile, const RenderRequest& request) const;
 
-    // A guess at what render_tile(tile) costs, in shaded rays (camera, reflection and refraction
-    // rays: shadow rays left out, cheap beside the shading they serve): those one camera sample
-    // traces at a probe pixel in each 4 × 4 block of the tile (8 × 8 under 16 samples per
+    // A guess at what render_tile(tile, request) costs, in shaded rays (camera, reflection and
+    // refraction rays: shadow rays left out, cheap beside the shading they serve): those one camera
+    // sample traces at a probe pixel in each 4 × 4 block of the tile (8 × 8 under 16 samples per
     // pixel), scaled to the tile's pixels. Ray counts, not clock time, so the guess is the same
     // on every machine and in every run; the probes cost 1/16 of one sample per pixel and change
     // no pixel.
-    std::uint64_t estimate_cost(const Tile& tile, const RenderRequest& request) const;
+    std::uint64_t tile_cost(const Tile& tile, const RenderRequest& request) const;
 
   private:
     // What one pixel's render leaves: its value, the spread of its samples, the camera samples it
@@ -113,7 +113,7 @@ class RenderContext {
     std::vector<Tile> tiles_;
 };
 
-// `tiles` with the costliest by estimate_cost first (equal guesses in index order): handed out in
+// `tiles` with the costliest by tile_cost first (equal guesses in index order): handed out in
 // this order, the slow tiles start early and the render's tail, when some workers have nothing
 // left while others finish, is one cheap tile long rather than one costly one. A render of one
 // worker gains nothing from it and gets `tiles` back untouched. `threads` (this process's)
