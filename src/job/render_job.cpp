@@ -91,6 +91,17 @@ MpiShare render_share(const RenderContext& context, const RenderRequest& request
     return share;
 }
 
+// The leader's figures of how the job's processes shared the tiles, `finished` when they had.
+void add_share(RenderStats& stats, const MpiShare& share, Clock::time_point finished,
+               const MpiJob* mpi) {
+    stats.threads = share.threads;
+    if (share.emptied) stats.tail_seconds = seconds_between(*share.emptied, finished);
+    stats.tile_messages = share.messages;
+    stats.receive_seconds = share.receive_seconds;
+    stats.assemble_seconds = share.assemble_seconds;
+    stats.processes = mpi ? mpi->size() : 1;
+}
+
 RenderJobResult run_job(const RenderContext& context, const RenderRequest& asked,
                         const RenderJobOptions& options, Clock::time_point start) {
     // A checkpoint keeps the estimate's sums: a render with one always estimates.
@@ -145,12 +156,7 @@ RenderJobResult run_job(const RenderContext& context, const RenderRequest& asked
     out.render = assembled(context, request, *image);
     out.done = image->tiles_done();
     RenderStats& stats = out.render.stats;
-    stats.threads = share.threads;
-    if (share.emptied) stats.tail_seconds = seconds_between(*share.emptied, finished);
-    stats.tile_messages = share.messages;
-    stats.receive_seconds = share.receive_seconds;
-    stats.assemble_seconds = share.assemble_seconds;
-    stats.processes = options.mpi ? options.mpi->size() : 1;
+    add_share(stats, share, finished, options.mpi);
     if (kept && !out.complete()) kept->write();
     stats.seconds = seconds_between(start, Clock::now());
     stats.setup_seconds = stats.seconds - seconds_between(tiles_start, finished);
