@@ -66,7 +66,7 @@ enum Tag : int {
     kGrant,        // from the leader: tile indices; none means there is no more work
     kResult,       // to the leader: one finished tile (encode_tile)
     kDone,         // to the leader: tile indices handed out but not rendered; nothing follows
-    kShared,       // from the leader, between renders: 32-bit values (MpiJob::leaders)
+    kShared,       // from the leader, between renders: 32-bit values (MpiJob::broadcast)
 };
 
 // How long a communication thread sleeps while it waits for a message: at first short against
@@ -473,11 +473,11 @@ MpiJob::MpiJob() {
 
 MpiJob::~MpiJob() = default;
 
-int MpiJob::leaders(int value) const {
-    return transport_->leaders(value);
+int MpiJob::broadcast(int value) const {
+    return transport_->broadcast(value);
 }
 
-std::vector<std::uint32_t> MpiJob::leaders(std::vector<std::uint32_t> values) const {
+std::vector<std::uint32_t> MpiJob::broadcast(std::vector<std::uint32_t> values) const {
     if (leader()) {
         std::vector<unsigned char> bytes(values.size() * sizeof(std::uint32_t));
         if (!values.empty()) std::memcpy(bytes.data(), values.data(), bytes.size());
@@ -498,8 +498,9 @@ int MpiJob::highest(int value) const {
     return transport_->highest(value);
 }
 
-MpiShare MpiJob::render(const RenderContext& context, std::vector<Tile> todo, TileSink& sink,
-                        const RenderOptions& options) const {
+MpiShare MpiJob::render_tiles(const RenderContext& context, const RenderRequest& request,
+                              std::vector<Tile> todo, TileSink& sink,
+                              const RenderOptions& options) const {
     RenderOptions run = options;
     if (run.threads <= 0) run.threads = share_of_machine(local_size());
     if (leader()) {
@@ -509,7 +510,7 @@ MpiShare MpiJob::render(const RenderContext& context, std::vector<Tile> todo, Ti
         std::jthread server([&] { serve(*transport_, context, queue, sink, share, served_error); });
         std::exception_ptr error;
         try {
-            share.threads = render_tiles(context, queue, sink, run);
+            share.threads = drt::render_tiles(context, request, queue, sink, run);
         } catch (...) {
             error = std::current_exception();
             queue.close();
@@ -520,7 +521,7 @@ MpiShare MpiJob::render(const RenderContext& context, std::vector<Tile> todo, Ti
         // Tiles given back by a process that stopped on its own, after the leader's workers
         // had run dry: everyone else has finished, so they are rendered here.
         if (!queue.empty() && !options.stop.stop_requested()) {
-            render_tiles(context, queue, sink, run);
+            drt::render_tiles(context, request, queue, sink, run);
         }
         share.emptied = queue.emptied();
         return share;
@@ -537,7 +538,7 @@ MpiShare MpiJob::render(const RenderContext& context, std::vector<Tile> todo, Ti
     MpiShare share;
     std::exception_ptr error;
     try {
-        share.threads = render_tiles(context, queue, outbox, run);
+        share.threads = drt::render_tiles(context, request, queue, outbox, run);
     } catch (...) {
         error = std::current_exception();
     }

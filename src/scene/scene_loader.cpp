@@ -753,6 +753,9 @@ class SceneReader {
         warn_children(e);
         auto mesh = build_mesh(in, std::move(obj), {}, false);
         if (mesh->dropped() > 0) context_.warn(e, "<Triangle> of zero area dropped");
+        if (mesh->collapsed() > 0) {
+            context_.warn(e, "<Triangle> too thin for single precision dropped");
+        }
         pending_.push_back({&e, std::move(material), std::move(surface),
                             [mesh = std::move(mesh)](const Material& m, SurfaceDetail d) {
                                 return std::make_unique<Mesh>(mesh, std::vector<Vec3>{Vec3{}}, m,
@@ -794,6 +797,10 @@ class SceneReader {
         if (const std::size_t n = mesh->dropped(); n > 0) {
             context_.warn(e, std::to_string(n) + (n == 1 ? " triangle" : " triangles") +
                                  " of zero area in " + obj_path.string() + " dropped");
+        }
+        if (const std::size_t n = mesh->collapsed(); n > 0) {
+            context_.warn(e, std::to_string(n) + (n == 1 ? " triangle" : " triangles") + " in " +
+                                 obj_path.string() + " too thin for single precision dropped");
         }
         pending_.push_back(
             {&e, std::move(material), std::move(surface),

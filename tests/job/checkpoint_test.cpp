@@ -214,16 +214,17 @@ TEST_F(TempDir, RendersStoppedAndResumedAtSeveralPointsGiveThePlainRendersBits) 
     for (const auto& adaptive : {std::optional<AdaptiveSampling>{},
                                  std::optional<AdaptiveSampling>{AdaptiveSampling{0.05, 2}}}) {
         const RenderResult reference = plain(scene, adaptive);
+        RenderRequest request = RenderRequest::whole_image(scene.settings);
+        request.adaptive = adaptive;
         RenderJobOptions options;
         options.threads = 1;  // stops after exactly the given count (two threads may overshoot)
-        options.adaptive = adaptive;
         options.checkpoint = dir_ / "c.ckpt";
         options.scene_files = {kEffects};
         RenderJobResult r;
         std::size_t resumed = 0;
         for (const std::size_t stop : {1, 2, 5}) {  // of 6 tiles
             options.stop_after_tiles = stop;
-            r = run_render_job(scene, options);
+            r = run_render_job(scene, request, options);
             ASSERT_FALSE(r.complete());
             EXPECT_EQ(r.resumed, resumed);
             EXPECT_EQ(r.done, stop);
@@ -232,7 +233,7 @@ TEST_F(TempDir, RendersStoppedAndResumedAtSeveralPointsGiveThePlainRendersBits) 
         }
         options.stop_after_tiles.reset();
         options.threads = 2;
-        r = run_render_job(scene, options);
+        r = run_render_job(scene, request, options);
         ASSERT_TRUE(r.complete());
         EXPECT_EQ(r.resumed, resumed);
         EXPECT_EQ(r.render.image.rgb, reference.image.rgb);
