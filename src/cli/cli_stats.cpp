@@ -95,7 +95,7 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
     }
     j << "  \"rays\": {\"camera\": " << rays.camera << ", \"shadow\": " << rays.shadow
       << ", \"reflection\": " << rays.reflection << ", \"refraction\": " << rays.refraction
-      << ", \"total\": " << rays.total() << "},\n"
+      << ", \"diffuse\": " << rays.diffuse << ", \"total\": " << rays.total() << "},\n"
       << "  \"million_rays_per_second\": "
       << json_number(r.stats.seconds > 0 ? rays.total() / r.stats.seconds / 1e6 : 0.0) << ",\n"
       << "  \"mean_spp\": " << json_number(double(r.stats.samples) / (double(s.width) * s.height))
@@ -120,7 +120,8 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
       << ", \"glossy_reflection\": " << json_bool(e.glossy_reflection)
       << ", \"glossy_refraction\": " << json_bool(e.glossy_refraction)
       << ", \"depth_of_field\": " << json_bool(e.depth_of_field)
-      << ", \"motion_blur\": " << json_bool(e.motion_blur) << "}\n}";
+      << ", \"motion_blur\": " << json_bool(e.motion_blur)
+      << ", \"indirect_light\": " << json_bool(e.indirect_light) << "}\n}";
     return j.str();
 }
 

@@ -22,8 +22,9 @@ using Bytes = std::vector<unsigned char>;
 // "DRTCKPT" and a format number: a reader refuses a format it does not know instead of guessing.
 // Format 2 added each pixel's spread and each tile's error sums (error_estimate.h); format 3
 // fingerprints each file the scene reads on its own (format 2 had one hash for them all); format 4
-// holds the error sums of the estimate's calibration instead of sobol's run spreads.
-constexpr char kMagic[8] = {'D', 'R', 'T', 'C', 'K', 'P', 'T', '4'};
+// holds the error sums of the estimate's calibration instead of sobol's run spreads; format 5
+// counts each tile's diffuse rays (the path integrator's).
+constexpr char kMagic[8] = {'D', 'R', 'T', 'C', 'K', 'P', 'T', '5'};
 // The longest version string a reader accepts, so a damaged length cannot ask for gigabytes.
 constexpr std::uint32_t kMaxVersionLength = 256;
 // Likewise for a file's name (PATH_MAX on Linux).
@@ -56,6 +57,7 @@ class Writer {
         u64(t.rays.shadow);
         u64(t.rays.reflection);
         u64(t.rays.refraction);
+        u64(t.rays.diffuse);
         u64(t.samples);
         u64(t.converged);
     }
@@ -107,6 +109,7 @@ class Reader {
         t.rays.shadow = u64();
         t.rays.reflection = u64();
         t.rays.refraction = u64();
+        t.rays.diffuse = u64();
         t.samples = u64();
         t.converged = u64();
         return t;

@@ -62,7 +62,7 @@ RenderContext::RenderContext(const Scene& scene, std::optional<AdaptiveSampling>
       sampler_(sampler_named(scene.settings.sampler)),
       plan_(plan_render(scene)),
       bvh_(scene.objects),
-      integrator_(scene, plan_, bvh_, *sampler_),
+      integrator_(make_integrator(scene, plan_, bvh_, *sampler_)),
       adaptive_(adaptive),
       estimate_error_(estimate_error),
       pixel_block_(std::max(1, pixel_block)),
@@ -200,13 +200,13 @@ std::uint64_t RenderContext::estimate_cost(const Tile& tile) const {
             const int py = std::min(y + block / 2, tile.y1 - 1);
             const PixelSample s{scene_.settings.seed,
                                 static_cast<std::uint32_t>(py * scene_.settings.width + px), 0, 1};
-            integrator_.sample_pixel(px, py, s, color, rays);
+            integrator_->sample_pixel(px, py, s, color, rays);
             ++pilots;
         }
     }
     // Shadow rays left out: a shading point's own work (its light sampling, textures, bump
     // maps) dwarfs what its shadow rays add (docs/design.md, "costliest first").
-    const std::uint64_t shaded = rays.camera + rays.reflection + rays.refraction;
+    const std::uint64_t shaded = rays.camera + rays.reflection + rays.refraction + rays.diffuse;
     const auto pixels = static_cast<std::uint64_t>(tile.width()) * tile.height();
     return pilots == 0 ? 0 : shaded * pixels / pilots;
 }
@@ -274,7 +274,7 @@ RenderContext::Pixel RenderContext::plain_pixel(int x, int y, std::uint64_t path
     const PixelSample s{scene_.settings.seed,
                         static_cast<std::uint32_t>(y * scene_.settings.width + x), 0, spp, path};
     scratch.colors.resize(spp);
-    integrator_.sample_pixel(x, y, s, scratch.colors, rays);
+    integrator_->sample_pixel(x, y, s, scratch.colors, rays);
     Color sum;
     for (const Color& c : scratch.colors) sum += c;
     if (sampler_->independent() || !plan_.effects.antialiasing || !estimate_error_) {
@@ -313,7 +313,7 @@ RenderContext::Pixel RenderContext::adaptive_pixel(int x, int y, std::uint64_t p
         }
         s.index = progressive ? n : 0;
         scratch.colors.resize(batch);
-        integrator_.sample_pixel(x, y, s, scratch.colors, rays);
+        integrator_->sample_pixel(x, y, s, scratch.colors, rays);
         for (const Color& c : scratch.colors) {
             sum += c;
             luminances.push_back(luminance(c));

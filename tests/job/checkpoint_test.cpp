@@ -284,7 +284,7 @@ TEST_F(CheckpointCli, DamagedTruncatedAndForeignCheckpointsExitTwoAndChangeNothi
     format2[7] = '2';
     const std::vector<std::pair<std::string, std::string>> cases{
         {format2,
-         "checkpoint format 2 of another drt version, this one reads format 4: not resumed and "
+         "checkpoint format 2 of another drt version, this one reads format 5: not resumed and "
          "nothing written (delete it or name another --checkpoint file)"},
         {damaged, "checksum does not match"},
         {good.substr(0, good.size() - 100), "checksum does not match"},

@@ -12,6 +12,7 @@
 
 #include "drt/accel/bvh.h"
 #include "drt/render/integrator.h"
+#include "drt/render/pixel_integrator.h"
 #include "drt/render/render_plan.h"
 #include "drt/render/tile.h"
 #include "drt/sampling/sampler.h"
@@ -126,7 +127,7 @@ class RenderContext {
     std::unique_ptr<Sampler> sampler_;
     RenderPlan plan_;
     Bvh bvh_;
-    Integrator integrator_;
+    std::unique_ptr<const PixelIntegrator> integrator_;  // the one the scene names
     std::optional<AdaptiveSampling> adaptive_;
     bool estimate_error_;
     int pixel_block_;
