@@ -4,14 +4,17 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "drt/accel/mesh.h"
 #include "drt/render/integrator.h"
 #include "drt/render/renderer.h"
 #include "drt/scene/scene_loader.h"
+#include "test_meshes.h"
 #include "test_scenes.h"
 
 namespace drt {
@@ -129,6 +132,74 @@ TEST(Emitters, EmittingSphereLightsAFloorAsTheClosedFormInBothIntegrators) {
     expect_relative(
         render_with(from_xml(floor_under_sphere("path", "stratified", 4096, 4))).image.at(0, 0),
         expected, 0.005, "path");
+}
+
+// A closed box of 12 emitting triangles (emission Le, diffuse 1, kd rho) around the camera: the
+// furnace again, now sampled by area over triangles, with the shadow rays shared among the
+// triangles (ShadowRays 12) or each picking one (ShadowRays 1).
+std::string emitting_box(const std::string& integrator, int shadow_rays, int max_depth) {
+    std::string triangles;
+    // Corner i of the cube has coordinate `bit` at +5 where that bit of i is set.
+    const auto coordinate = [](int corner, int bit) { return (corner >> bit & 1) ? "5" : "-5"; };
+    const int faces[6][4] = {{0, 1, 3, 2}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                             {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 3, 7, 5}};
+    for (const auto& f : faces) {
+        for (const auto& t : {std::array<int, 3>{f[0], f[1], f[2]}, {f[0], f[2], f[3]}}) {
+            triangles += "<Triangle";
+            for (int k = 0; k < 3; ++k) {
+                for (int bit = 0; bit < 3; ++bit) {
+                    triangles += std::string(" ") + char('A' + k) + "xyz"[bit] + "=\"" +
+                                 coordinate(t[k], bit) + "\"";
+                }
+            }
+            triangles += " Material=\"Wall\"/>\n";
+        }
+    }
+    return R"(<Scene><Image Width="8" Height="8"/>
+      <Render Integrator=")" +
+           integrator + R"(" Samples="256" ShadowRays=")" + std::to_string(shadow_rays) +
+           R"(" MaxDepth=")" + std::to_string(max_depth) + R"(" Sampler="random"/>
+      <Camera Ex="0.3" Ey="0.2" Ez="0.1" Lx="1" Ly="0.5" Lz="3" Fov="90"/>
+      <Materials><Wall diffuse="1" kdr="0.5" kdg="0.5" kdb="0.5" ker="2" keg="2" keb="2"/>
+      </Materials>)" +
+           triangles + "</Scene>";
+}
+
+TEST(Emitters, EmittingTrianglesLightTheInsideOfAClosedBoxInBothIntegrators) {
+    for (const int shadow_rays : {12, 1}) {
+        // Distributed: the emission seen plus its direct light, Le·(1 + rho).
+        const Color direct =
+            image_mean(render_with(from_xml(emitting_box("distributed", shadow_rays, 8))).image);
+        EXPECT_NEAR(direct.r, 2 * 1.5, 0.01 * 3) << shadow_rays;
+        // Path: every bounce, Le·(1 + rho + ... + rho^MaxDepth).
+        const Color path =
+            image_mean(render_with(from_xml(emitting_box("path", shadow_rays, 8))).image);
+        const double expected = 2 * geometric_sum(0.5, 9);
+        EXPECT_NEAR(path.r, expected, 0.01 * expected) << shadow_rays;
+    }
+}
+
+// The furnace inside one emitting mesh of 320 triangles of unequal area: next-event estimation
+// picks its triangles by area.
+TEST(Emitters, EmittingMeshFurnaceInBothIntegrators) {
+    for (const IntegratorKind kind : {IntegratorKind::kDistributed, IntegratorKind::kPath}) {
+        Scene scene = testing::blank_scene(8, 8, 256);
+        scene.settings.integrator = kind;
+        scene.settings.sampler = "random";
+        scene.settings.max_depth = 6;
+        scene.view = LookAt{{0.5, 0.25, 0}, {1, 1, 3}, {0, 1, 0}, 90};
+        Material wall = testing::grey_lambert(0.5);
+        wall.emission = {2, 2, 2};
+        const Material& m = testing::add_material(scene, wall);
+        auto mesh = std::make_shared<const TriangleMesh>(testing::obj_of(testing::icosphere(2, 10)),
+                                                         MeshTransform{}, false);
+        scene.objects.push_back(std::make_unique<Mesh>(mesh, std::vector<Vec3>{Vec3{}}, m));
+        const RenderPlan plan = plan_render(scene);
+        ASSERT_EQ(plan.emitters.size(), 1u);
+        ASSERT_EQ(plan.emitters[0].mesh->triangle_count(), 320u);
+        const double expected = 2 * (kind == IntegratorKind::kPath ? geometric_sum(0.5, 7) : 1.5);
+        EXPECT_NEAR(image_mean(render_with(scene).image).g, expected, 0.01 * expected);
+    }
 }
 
 TEST(Emitters, EmittingSphereIsSeenByCameraRaysInBothIntegrators) {
