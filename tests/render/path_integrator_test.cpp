@@ -297,6 +297,24 @@ TEST(PathIntegrator, ShadowRaysScatteredRaysAndTheirWeighingAgree) {
     }
 }
 
+// Light reaching the eye by glossy reflections of an emitter alone: the distributed integrator
+// follows the same lobes, so both integrators have one mean (nothing found twice).
+TEST(PathIntegrator, GlossyOnlySceneHasTheDistributedIntegratorsMean) {
+    const auto scene = [](const std::string& integrator) {
+        return from_xml(R"(<Scene><Image Width="16" Height="16"/>
+          <Render Integrator=")" +
+                        integrator + R"(" Samples="1024" MaxDepth="3" Sampler="random"/>
+          <Camera Ex="0" Ey="6" Ez="-12" Lx="0" Ly="0" Lz="0" Fov="50"/>
+          <Materials><Metal reflective="0.9" ksr="1" ksg="0.8" ksb="0.6" n="4"/>
+            <Glow ker="3" keg="2" keb="1"/></Materials>
+          <Plane Px="0" Py="0" Pz="0" Vu="0" Vv="1" Vw="0" Material="Metal"/>
+          <Sphere Px="0" Py="3" Pz="4" Radius="2" Material="Glow"/></Scene>)");
+    };
+    const Color distributed = image_mean(render_with(scene("distributed")).image);
+    const Color path = image_mean(render_with(scene("path")).image);
+    expect_relative(path, distributed, 0.01, "glossy");
+}
+
 TEST(PathIntegrator, ImageIsTheSameOnAnyNumberOfThreads) {
     for (const std::string sampler : {"stratified", "sobol"}) {
         Scene scene = testing::scaled_scene("gi/cornell-box.xml", 24, 4);
