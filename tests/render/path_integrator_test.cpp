@@ -40,11 +40,11 @@ Color image_mean(const Image& image) {
 
 // A camera inside a closed sphere of emission Le, diffuse 1, kd rho: every path sees Le at each
 // of its up to MaxDepth + 1 surface points, weighed by rho per scattering event.
-std::string furnace(double le, double rho, int max_depth) {
+std::string furnace(double le, double rho, int max_depth, const std::string& sampler = "random") {
     const std::string e = std::to_string(le), r = std::to_string(rho);
     return R"(<Scene><Image Width="8" Height="8"/>
       <Render Integrator="path" Samples="256" MaxDepth=")" +
-           std::to_string(max_depth) + R"(" Sampler="random"/>
+           std::to_string(max_depth) + R"(" Sampler=")" + sampler + R"("/>
       <Camera Ex="0" Ey="0" Ez="0" Lx="0" Ly="0" Lz="1" Fov="90"/>
       <Materials><Wall diffuse="1" kdr=")" +
            r + "\" kdg=\"" + r + "\" kdb=\"" + r + "\" ker=\"" + e + "\" keg=\"" + e + "\" keb=\"" +
@@ -75,6 +75,39 @@ TEST(PathIntegrator, FurnaceConvergesToTheGeometricSeries) {
         EXPECT_NEAR(mean.g, expected, 0.01 * expected);
         EXPECT_NEAR(mean.b, expected, 0.01 * expected);
         EXPECT_EQ(r.stats.rays.diffuse > 0, c.max_depth > 0);
+    }
+}
+
+// Every sampler gives each scattering event dimensions of its own: a pattern shared between
+// bounces would correlate them and bias the sum.
+TEST(PathIntegrator, FurnaceConvergesWithEverySampler) {
+    for (const std::string sampler : {"stratified", "sobol"}) {
+        const Color mean = image_mean(render_with(from_xml(furnace(1.0, 0.8, 16, sampler))).image);
+        const double expected = geometric_sum(0.8, 17);
+        EXPECT_NEAR(mean.r, expected, 0.01 * expected) << sampler;
+    }
+}
+
+// An emitting plane is not sampled by shadow rays: the path integrator finds its light by
+// scattered rays, every one of which meets it here, so a floor under it shows exactly
+// diffuse·kd·Le; the distributed integrator shows the plane but lights nothing with it.
+TEST(Emitters, EmittingPlaneLightsByScatteredRaysOnly) {
+    for (const std::string integrator : {"distributed", "path"}) {
+        const Scene scene = from_xml(R"(<Scene><Image Width="4" Height="4"/>
+          <Render Integrator=")" + integrator +
+                                     R"(" Samples="16" MaxDepth="4"/>
+          <Camera Ex="0" Ey="5" Ez="0" Lx="0" Ly="0" Lz="0" Uz="1" Fov="30"/>
+          <Materials><Floor diffuse="0.5" kdr="1" kdg="0.5" kdb="0.25"/>
+            <Sky ker="2" keg="2" keb="2"/></Materials>
+          <Plane Px="0" Py="0" Pz="0" Vu="0" Vv="1" Vw="0" Material="Floor"/>
+          <Plane Px="0" Py="10" Pz="0" Vu="0" Vv="-1" Vw="0" Material="Sky"/></Scene>)");
+        const RenderResult r = render_with(scene);
+        EXPECT_EQ(r.plan.emitters.size(), 0u);
+        const Color floor = r.image.at(2, 2);
+        const double scale = integrator == "path" ? 0.5 * 2 : 0;
+        EXPECT_NEAR(floor.r, scale * 1, 1e-9) << integrator;
+        EXPECT_NEAR(floor.g, scale * 0.5, 1e-9);
+        EXPECT_NEAR(floor.b, scale * 0.25, 1e-9);
     }
 }
 
