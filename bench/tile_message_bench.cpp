@@ -8,7 +8,7 @@
 #include <optional>
 #include <vector>
 
-#include "drt/job/checkpoint.h"
+#include "drt/job/tile_codec.h"
 #include "drt/render/tile.h"
 
 namespace drt::bench {
@@ -45,7 +45,7 @@ void BM_TileMessageDecode(benchmark::State& state) {
     const Messages m;
     std::size_t i = 0;
     for (auto _ : state) {
-        benchmark::DoNotOptimize(decode_tile(m.encoded[i], m.grid, "bench"));
+        benchmark::DoNotOptimize(decode_tile(m.encoded[i], m.grid));
         i = (i + 1) % m.grid.size();
     }
     state.SetBytesProcessed(std::int64_t(state.iterations()) * std::int64_t(m.encoded[0].size()));
@@ -63,7 +63,7 @@ void BM_TileMessageDecodeAndAssemble(benchmark::State& state) {
             sink.emplace(kWidth, kHeight, m.grid);
             state.ResumeTiming();
         }
-        sink->add(decode_tile(m.encoded[i], m.grid, "bench"));
+        sink->add(decode_tile(m.encoded[i], m.grid));
         i = (i + 1) % m.grid.size();
     }
 }

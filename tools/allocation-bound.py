@@ -26,7 +26,7 @@ import array
 import math
 import sys
 
-# A round meant as the last aims at this share of the target (kSpareShare, progressive.h).
+# A round meant as the last aims at this share of the target (kSpareShare, goal_render.h).
 SPARE_SHARE = 0.98
 
 

@@ -3,7 +3,8 @@
 # Release build for this machine's processor against the portable sanitizer build: rounding
 # must not depend on the instruction set, the optimisation level or the instrumentation.
 # Usage: tools/compare-builds.sh A B [--scale F]   (default scale 0.1, a few seconds per scene
-# under the sanitizers)
+# under the sanitizers). tools/compare-modes.sh compares the render modes, statistics,
+# checkpoints and messages too.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [ $# -ge 2 ] || { echo "usage: tools/compare-builds.sh A B [--scale F]" >&2; exit 2; }

@@ -6,9 +6,10 @@
 #include <cmath>
 #include <limits>
 
-#include "drt/accel/mesh.h"
+#include "drt/accel/triangle_mesh.h"
 #include "drt/geometry/plane.h"
 #include "drt/geometry/sphere.h"
+#include "drt/util/float_rounding.h"
 
 namespace drt {
 
@@ -29,18 +30,6 @@ constexpr double kFarStretch = 1.0 + 4.0 * std::numeric_limits<double>::epsilon(
 
 Interval span(const Interval& a, const Interval& b) {
     return {std::min(a.min, b.min), std::max(a.max, b.max)};
-}
-
-// A time bound as a float that still contains the double: down for a minimum, up for a maximum.
-float float_below(double v) {
-    float f = static_cast<float>(v);
-    if (static_cast<double>(f) > v) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
-    return f;
-}
-float float_above(double v) {
-    float f = static_cast<float>(v);
-    if (static_cast<double>(f) < v) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-    return f;
 }
 
 }  // namespace
@@ -166,8 +155,8 @@ std::uint32_t Bvh::build(std::vector<Build>& items, std::uint32_t begin, std::ui
     {
         Node& node = nodes_[index];
         for (int a = 0; a < 3; ++a) node.box[a] = bounds.lo[a], node.box[3 + a] = bounds.hi[a];
-        node.time_min = float_below(time.min);
-        node.time_max = float_above(time.max);
+        node.time_min = to_float_down(time.min);
+        node.time_max = to_float_up(time.max);
     }
     const std::uint32_t count = end - begin;
 

@@ -12,8 +12,6 @@ namespace drt {
 
 namespace {
 
-using Float3 = std::array<float, 3>;
-
 constexpr std::uint32_t kMaxLeaf = 8;
 constexpr int kBins = 16;
 // Past this depth a node is split at its median, so that no path is longer than 40 + log2(n)

@@ -2,11 +2,9 @@
 
 #include <exception>
 #include <iostream>
-#include <new>
 #include <string>
 
 #include "cli_common.h"
-#include "drt/util/text.h"
 
 namespace drt {
 
@@ -22,12 +20,9 @@ int run_cli(int argc, const char* const* argv, std::ostream& out, std::ostream& 
             if (command == "converge") return cli::converge_command(argc - 1, argv + 1, out, err);
         }
         return cli::render_command(argc, argv, out, err, mpi);
-    } catch (const std::bad_alloc&) {
-        err << "drt: out of memory\n";
     } catch (const std::exception& e) {
-        err << "drt: " << printable(e.what()) << "\n";
+        return cli::report_failure(e, "drt", "", err);
     }
-    return cli::kFailed;
 }
 
 }  // namespace drt

@@ -5,10 +5,15 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <new>
 #include <ostream>
 
+#include "drt/io/image.h"
+#include "drt/job/checkpoint.h"
 #include "drt/sampling/sampler.h"
+#include "drt/scene/scene_loader.h"
 #include "drt/util/atomic_file.h"
+#include "drt/util/interrupt.h"
 #include "drt/util/limits.h"
 #include "drt/util/text.h"
 
@@ -132,6 +137,32 @@ std::optional<int> parse_arguments(CLI::App& app, int argc, const char* const* a
         return kBadInput;
     }
     return std::nullopt;
+}
+
+int report_failure(const std::exception& error, const std::string& command,
+                   const std::string& subject, std::ostream& err) {
+    const std::string about = subject.empty() ? command + ": " : command + ": " + subject + ": ";
+    if (dynamic_cast<const SceneError*>(&error)) {
+        err << error.what() << "\n";  // names the file and the line itself
+    } else if (dynamic_cast<const ImageError*>(&error)) {
+        err << command << ": " << error.what() << "\n";
+    } else if (dynamic_cast<const CheckpointError*>(&error)) {
+        err << command << ": " << printable(error.what()) << "\n";
+    } else if (dynamic_cast<const LimitError*>(&error)) {
+        err << about << error.what() << "\n";
+    } else if (dynamic_cast<const std::bad_alloc*>(&error)) {
+        err << about << "out of memory\n";
+        return kFailed;
+    } else {
+        err << about << printable(error.what()) << "\n";
+        return kFailed;
+    }
+    return kBadInput;
+}
+
+int interrupted_status() {
+    const int signal = stop_signal().load();
+    return signal != 0 ? 128 + signal : kInterrupted;
 }
 
 }  // namespace drt::cli

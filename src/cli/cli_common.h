@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdint>
+#include <exception>
 #include <filesystem>
 #include <iosfwd>
 #include <optional>
@@ -12,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "drt/goal/progressive.h"
+#include "drt/goal/goal_render.h"
 #include "drt/render/render_context.h"
 #include "drt/scene/scene.h"
 
@@ -34,6 +35,17 @@ class LimitError : public std::runtime_error {
   public:
     using std::runtime_error::runtime_error;
 };
+
+// The status a command exits with after `error`, whose message it writes on `err`: bad input
+// (kBadInput) for a scene, image, checkpoint or limit error, a failure (kFailed) for any other,
+// out of memory included. Messages start with `command` ("drt converge"); a limit error and a
+// failure also name `subject` (printable: the scene the command works on) unless it is empty.
+int report_failure(const std::exception& error, const std::string& command,
+                   const std::string& subject, std::ostream& err);
+
+// The status of a render stopped before its end: 128 + the signal that stopped it, or
+// kInterrupted when --stop-after-tiles stood for one.
+int interrupted_status();
 
 // An integer option from `lowest` to `limit` (messages are made printable where they are shown).
 // CLI11's own range checks print a double's bounds in full (309 digits) and its unsigned conversion
@@ -74,12 +86,13 @@ struct AdaptiveFlags {
 // Writes text and a final newline through a temporary file and a rename, like the images.
 void write_text_atomically(const std::filesystem::path& path, const std::string& text);
 
-// The pilot rounds a render of `scene` to `target` takes (progressive.h) and what they predict
+// The rounds before the final one that a render of `scene` to `target` takes (goal_render.h) and
+// what they predict
 // for its final round: `drt info --target-error`, and `drt converge --target-error` beside what
 // it measures (cli_info.cpp).
 struct GoalForecast {
-    std::vector<ProgressiveRound> pilots;
-    int final_round = 0;              // the final round's count; 0 when the pilots reach it
+    std::vector<GoalRound> rounds;
+    int final_round = 0;              // the final round's count; 0 when the rounds reach it
     std::optional<Prediction> total;  // all rounds together
     // All rounds together if the final round's error falls only as N^-1/2 (that of independent
     // samples): the final round is sized on the short side, so where it falls short this is the
@@ -87,7 +100,7 @@ struct GoalForecast {
     std::optional<Prediction> slow;
 };
 
-GoalForecast forecast(Scene& scene, double target, int threads);
+GoalForecast forecast(const Scene& scene, double target, int threads);
 std::string forecast_text(const GoalForecast& f, double target);
 
 // The commands, each in a file of its own. argv as CLI11 parses it: argv[0] names the program or

@@ -48,11 +48,9 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
         image_b = read_image(b);
         c = compare_images(image_a, image_b);
     } catch (const ImageError& e) {
-        err << "drt compare: " << e.what() << "\n";
-        return kBadInput;
-    } catch (const std::bad_alloc&) {
-        err << "drt compare: out of memory\n";
-        return kFailed;
+        return report_failure(e, "drt compare", "", err);
+    } catch (const std::bad_alloc& e) {  // any other failure reaches run_cli's last guard
+        return report_failure(e, "drt compare", "", err);
     }
     out << comparison_fields(c) << "\n";
     int status = kOk;

@@ -7,7 +7,7 @@
 #include <utility>
 
 #include "cli_common.h"
-#include "drt/goal/progressive.h"
+#include "drt/goal/goal_render.h"
 #include "drt/job/render_job.h"
 #include "drt/render/render_plan.h"
 #include "drt/scene/scene_loader.h"
@@ -16,29 +16,29 @@
 
 namespace drt::cli {
 
-GoalForecast forecast(Scene& scene, double target, int threads) {
-    ProgressiveGoal goal;
+GoalForecast forecast(const Scene& scene, double target, int threads) {
+    RenderGoal goal;
     goal.target_error = target;
     goal.max_samples = kMaxSamples;
-    goal.pilots_only = true;
+    goal.stop_before_final = true;
     RenderJobOptions options;
     options.threads = threads;
     GoalForecast f;
-    const ProgressiveResult pilots = render_progressively(scene, options, goal);
-    f.pilots = pilots.rounds;
-    if (pilots.rounds.empty()) return f;
+    const GoalResult before_final = render_to_goal(scene, options, goal);
+    f.rounds = before_final.rounds;
+    if (f.rounds.empty()) return f;
     double seconds = 0;
-    for (const ProgressiveRound& r : pilots.rounds) seconds += r.seconds;
-    const NextRound last = next_round(pilots.rounds, target, kMaxSamples);
+    for (const GoalRound& r : f.rounds) seconds += r.seconds;
+    const NextRound last = next_round(f.rounds, target, kMaxSamples);
     if (last.spp == 0) {
-        f.total = Prediction{pilots.samples, seconds};
+        f.total = Prediction{before_final.samples, seconds};
     } else if (last.final) {
         f.final_round = last.spp;
-        f.total = Prediction{pilots.samples + last.spp,
-                             seconds + predicted_seconds(pilots.rounds, last.spp)};
-        if (const auto slow = predict(pilots.rounds, target, kMaxSamples, -0.5);
+        f.total = Prediction{before_final.samples + last.spp,
+                             seconds + predicted_seconds(f.rounds, last.spp)};
+        if (const auto slow = predict(f.rounds, target, kMaxSamples, -0.5);
             slow && slow->spp > last.spp) {
-            f.slow = Prediction{pilots.samples + slow->spp, seconds + slow->seconds};
+            f.slow = Prediction{before_final.samples + slow->spp, seconds + slow->seconds};
         }
     }
     return f;
@@ -47,19 +47,20 @@ GoalForecast forecast(Scene& scene, double target, int threads) {
 std::string forecast_text(const GoalForecast& f, double target) {
     std::ostringstream text;
     text << "pilots:";
-    for (const ProgressiveRound& r : f.pilots) {
+    for (const GoalRound& r : f.rounds) {
         text << " " << r.spp << " spp";
-        if (!r.full()) text << " on 1 pixel in " << r.pixel_block * r.pixel_block << ",";
+        if (r.kind == RoundKind::kPilot)
+            text << " on 1 pixel in " << r.pixel_block * r.pixel_block << ",";
         text << " " << std::fixed << std::setprecision(3) << r.seconds << " s, estimated rmse "
              << std::defaultfloat << (r.error ? short_number(*r.error) : std::string("n/a")) << ";";
     }
     text << "\npredicted for --target-error " << short_number(target) << ": ";
     if (f.total) {
-        // The goal render repeats the pilots, then adds the final round to them.
+        // The goal render repeats these rounds, then adds the final round to them.
         text << f.total->spp << " spp, " << std::fixed << std::setprecision(2) << f.total->seconds
              << " s on this machine (rounds of " << std::defaultfloat;
         const char* separator = "";
-        for (const ProgressiveRound& r : f.pilots) {
+        for (const GoalRound& r : f.rounds) {
             if (r.full()) text << std::exchange(separator, ", ") << r.spp;
         }
         if (f.final_round > 0) text << separator << f.final_round;
@@ -96,11 +97,9 @@ int info_command(int argc, const char* const* argv, std::ostream& out, std::ostr
         out << describe(loaded.scene, plan_render(loaded.scene));
         if (target) out << forecast_text(forecast(loaded.scene, *target, threads), *target);
     } catch (const SceneError& e) {
-        err << e.what() << "\n";
-        return kBadInput;
-    } catch (const LimitError& e) {
-        err << "drt info: " << printable(scene_path) << ": " << e.what() << "\n";
-        return kBadInput;
+        return report_failure(e, "drt info", printable(scene_path), err);
+    } catch (const LimitError& e) {  // bad input only: a failure reaches run_cli's last guard
+        return report_failure(e, "drt info", printable(scene_path), err);
     }
     return kOk;
 }

@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
-#include <new>
 #include <optional>
 #include <sstream>
 #include <stop_token>
@@ -17,9 +16,8 @@
 
 #include "cli_common.h"
 #include "cli_render.h"
-#include "drt/goal/progressive.h"
+#include "drt/goal/goal_render.h"
 #include "drt/io/image.h"
-#include "drt/job/checkpoint.h"
 #include "drt/job/mpi_work.h"
 #include "drt/job/render_job.h"
 #include "drt/render/error_estimate.h"
@@ -71,7 +69,7 @@ class ProgressDisplay {
     std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
-// --target-error and --time-limit: rounds of renders until the goal (progressive.h).
+// --target-error and --time-limit: rounds of renders until the goal (goal_render.h).
 struct GoalFlags {
     std::optional<double> target_error, time_limit;
 
@@ -94,7 +92,8 @@ struct GoalFlags {
     bool wanted() const { return target_error || time_limit; }
 };
 
-struct RenderJob {
+// What the render command was asked, shared by every scene it renders.
+struct RenderCommand {
     Overrides overrides;
     AdaptiveFlags adaptive;
     GoalFlags goal;
@@ -121,7 +120,7 @@ struct RenderJob {
 // What an .exr header records about the render, so that the file says how it was made, and how
 // good it is: `estimatedError`, the estimated RMSE, when there is one.
 ImageWriteOptions output_options(const Scene& scene, const RenderResult& result,
-                                 const RenderJob& job) {
+                                 const RenderCommand& job) {
     const RenderSettings& s = scene.settings;
     ImageWriteOptions options;
     options.half = job.exr_half;
@@ -171,7 +170,7 @@ class SignalStop {
 };
 
 // What a render to a goal reached, and how to render the same image again.
-std::string goal_summary(const std::string& name, const ProgressiveResult& p, const GoalFlags& goal,
+std::string goal_summary(const std::string& name, const GoalResult& p, const GoalFlags& goal,
                          double seconds) {
     std::ostringstream line;
     line << "drt: " << name << ": " << p.samples << " spp after ";
@@ -180,8 +179,8 @@ std::string goal_summary(const std::string& name, const ProgressiveResult& p, co
     // top-up (a time limit's cut) as "a round of N spp".
     bool listing = false;  // inside the list of full rounds, " spp" still to come
     bool topped = false;
-    for (const ProgressiveRound& r : p.rounds) {
-        if (!r.full() && !r.top_up()) {
+    for (const GoalRound& r : p.rounds) {
+        if (r.kind == RoundKind::kPilot) {
             line << "a pilot of " << r.spp << " spp on 1 pixel in " << r.pixel_block * r.pixel_block
                  << ", ";
         } else if (r.top_up()) {
@@ -208,11 +207,10 @@ std::string goal_summary(const std::string& name, const ProgressiveResult& p, co
         line << "; " << std::fixed << std::setprecision(2) << seconds << " s of the "
              << short_number(*goal.time_limit) << " s limit" << std::defaultfloat;
     }
-    const auto full =
-        std::count_if(p.rounds.begin(), p.rounds.end(),
-                      [](const ProgressiveRound& r) { return r.full() || r.top_up(); });
+    const auto full = std::count_if(p.rounds.begin(), p.rounds.end(),
+                                    [](const GoalRound& r) { return r.kind != RoundKind::kPilot; });
     if (!p.combined || full == 1) {
-        // A target error's one full round is the plain render of its count (progressive.h).
+        // A target error's one full round is the plain render of its count (goal_render.h).
         line << "\ndrt: " << name << ": --spp " << p.samples
              << " renders the same image (bit-identical) without a goal\n";
     } else {
@@ -231,28 +229,21 @@ fs::path partial_path(const fs::path& output) {
            (output.stem().string() + ".partial" + output.extension().string());
 }
 
+// `<stem>.nonfinite.pfm` beside the output: a render with non-finite pixels fails (exit 2) and
+// leaves the output as it was; the image is kept here, as a .pfm since it holds NaN and infinity.
+fs::path nonfinite_path(const fs::path& output) {
+    return output.parent_path() / (output.stem().string() + ".nonfinite.pfm");
+}
+
 // Runs `step`, turning every exception into a message and a status.
 template <typename Step>
 int guarded(const std::string& name, std::ostream& err, Step&& step) {
     try {
         step();
         return kOk;
-    } catch (const SceneError& e) {
-        err << e.what() << "\n";
-    } catch (const ImageError& e) {
-        err << "drt: " << e.what() << "\n";
-    } catch (const CheckpointError& e) {
-        err << "drt: " << printable(e.what()) << "\n";
-    } catch (const LimitError& e) {
-        err << "drt: " << name << ": " << e.what() << "\n";
-    } catch (const std::bad_alloc&) {
-        err << "drt: " << name << ": out of memory\n";
-        return kFailed;
     } catch (const std::exception& e) {
-        err << "drt: " << name << ": " << printable(e.what()) << "\n";
-        return kFailed;
+        return report_failure(e, "drt", name, err);
     }
-    return kBadInput;
 }
 
 // One scene, start to end. Everything that can go wrong ends here as a message and a status, so
@@ -260,7 +251,7 @@ int guarded(const std::string& name, std::ostream& err, Step&& step) {
 // runs it, and all agree on the status after each step, so that none waits for another that
 // gave up.
 SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
-                        const std::optional<fs::path>& checkpoint, const RenderJob& job,
+                        const std::optional<fs::path>& checkpoint, const RenderCommand& job,
                         std::ostream& err) {
     const auto start = std::chrono::steady_clock::now();  // a time limit counts from here
     SceneOutcome outcome;
@@ -284,9 +275,11 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
         return outcome;
     }
     const Scene& scene = loaded->scene;
+    RenderRequest request = RenderRequest::whole_image(scene.settings);
+    request.adaptive = job.adaptive.settings();
+    request.estimate_error = job.estimate_shown || format_for_path(output) == ImageFormat::kExr;
     RenderJobOptions options;
     options.threads = job.threads;
-    options.adaptive = job.adaptive.settings();
     options.checkpoint = checkpoint;
     options.scene_files = {scene_path};
     options.scene_files.insert(options.scene_files.end(), loaded->files_read.begin(),
@@ -294,7 +287,6 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
     options.checkpoint_interval = std::chrono::duration<double>(job.checkpoint_seconds);
     options.stop_after_tiles = job.stop_after_tiles;
     options.costly_first = !job.grid_order;
-    options.estimate_error = job.estimate_shown || format_for_path(output) == ImageFormat::kExr;
     options.stop = job.stop;
     options.mpi = job.mpi;
     std::optional<ProgressDisplay> display;
@@ -303,18 +295,18 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
         options.on_progress = [&](double done) { (*display)(done); };
     }
     RenderJobResult r;
-    std::optional<ProgressiveResult> rounds;
+    std::optional<GoalResult> rounds;
     status = guarded(name, err, [&] {
         if (!job.goal.wanted()) {
-            r = run_render_job(scene, options);
+            r = run_render_job(scene, request, options);
             return;
         }
-        ProgressiveGoal goal;
+        RenderGoal goal;
         goal.target_error = job.goal.target_error;
         goal.time_limit = job.goal.time_limit;
         goal.max_samples = job.overrides.spp.value_or(kMaxSamples);
         goal.start = start;
-        rounds = render_progressively(loaded->scene, options, goal);
+        rounds = render_to_goal(scene, options, goal);
         r = std::move(rounds->job);
         loaded->scene.settings.samples = rounds->samples;
         r.render.stats.seconds =
@@ -331,7 +323,10 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
     outcome.seconds = result.stats.seconds;
     outcome.mrays_per_second =
         result.stats.seconds > 0 ? result.stats.rays.total() / result.stats.seconds / 1e6 : 0;
-    const fs::path target = r.complete() ? output : partial_path(output);
+    const std::size_t nonfinite = r.complete() ? count_nonfinite(result.image) : 0;
+    const fs::path target = !r.complete()   ? partial_path(output)
+                            : nonfinite > 0 ? nonfinite_path(output)
+                                            : output;
     try {
         write_image(result.image, target, output_options(scene, result, job));
     } catch (const ImageError& e) {
@@ -340,7 +335,6 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
         return outcome;
     }
     if (!r.complete()) {
-        const int sig = stop_signal().load();
         err << "drt: " << name << ": interrupted with " << r.done << " of " << r.tiles
             << " tiles done; wrote " << printable(target.string());
         if (checkpoint) {
@@ -352,13 +346,12 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
         } else {
             err << "\ndrt: with --checkpoint FILE an interrupted render can be resumed\n";
         }
-        outcome.status = job.agree(sig != 0 ? 128 + sig : kInterrupted);
+        outcome.status = job.agree(interrupted_status());
         return outcome;
     }
     outcome.json = stats_json(
         scene, result,
-        rounds ? goal_json(*rounds, job.goal.target_error, job.goal.time_limit, scene.settings.seed)
-               : std::string());
+        rounds ? goal_json(*rounds, job.goal.target_error, job.goal.time_limit) : std::string());
     if (!job.error_image.empty()) {
         try {
             write_image(standard_error_image(result.spread, result.stats.error), job.error_image,
@@ -376,7 +369,7 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
         if (r.resumed > 0) fs::remove(partial_path(output), ignored);
     }
     if (!job.quiet) {
-        err << "drt: wrote " << printable(output.string()) << " (" << outcome.width << "x"
+        err << "drt: wrote " << printable(target.string()) << " (" << outcome.width << "x"
             << outcome.height << ", " << outcome.samples << " spp, " << std::fixed
             << std::setprecision(2) << outcome.seconds << " s";
         if (r.resumed > 0) err << ", " << r.resumed << " of " << r.tiles << " tiles resumed";
@@ -387,17 +380,19 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
     }
     if (rounds && rounds->stopped) {
         // Interrupted between or during rounds: the image is the complete rounds'.
-        const int sig = stop_signal().load();
         err << "drt: " << name << ": interrupted; kept "
             << (rounds->combined ? "the complete rounds combined\n" : "the last complete round\n");
-        outcome.status = job.agree(sig != 0 ? 128 + sig : kInterrupted);
+        outcome.status = job.agree(interrupted_status());
         return outcome;
     }
-    // Written all the same, for inspection, but not a success: no pixel may be silently lost.
-    if (const std::size_t bad = count_nonfinite(result.image)) {
-        err << "drt: " << name << ": " << bad << " of " << result.image.rgb.size()
+    // Kept for inspection, but not a success: no pixel may be silently lost.
+    if (nonfinite > 0) {
+        err << "drt: " << name << ": " << nonfinite << " of " << result.image.rgb.size()
             << " channel values are not finite (radiance beyond the float range: a light, "
-               "background or ambient too bright?)\n";
+               "background or ambient too bright?)\ndrt: "
+            << name << ": " << printable(output.string())
+            << " not written; the image is kept for inspection in " << printable(target.string())
+            << "\n";
         status = kBadInput;
     }
     outcome.status = job.agree(status);
@@ -415,7 +410,7 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
         "drt"};
     std::vector<std::string> scenes;
     std::string output, stats;
-    RenderJob job;
+    RenderCommand job;
     bool force_progress = false;
     app.add_option("scenes", scenes, "Scene file(s) in the thesis XML format")->required();
     app.add_option("-o,--output", output,

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "cli_common.h"
-#include "drt/goal/progressive.h"
+#include "drt/goal/goal_render.h"
 #include "drt/render/renderer.h"
 #include "drt/scene/scene.h"
 
@@ -52,7 +52,7 @@ struct BatchReport {
 std::string stats_json(const Scene& scene, const RenderResult& r, const std::string& goal = {});
 
 // The rounds of a render to a goal (--target-error, --time-limit), as lines of stats_json.
-std::string goal_json(const ProgressiveResult& p, const std::optional<double>& target,
-                      const std::optional<double>& limit, std::uint64_t seed);
+std::string goal_json(const GoalResult& p, const std::optional<double>& target,
+                      const std::optional<double>& limit);
 
 }  // namespace drt::cli

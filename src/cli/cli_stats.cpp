@@ -5,7 +5,7 @@
 #include <string>
 
 #include "cli_render.h"
-#include "drt/goal/progressive.h"
+#include "drt/goal/goal_render.h"
 #include "drt/render/error_estimate.h"
 #include "drt/render/render_plan.h"
 
@@ -42,27 +42,25 @@ std::string json_string(const std::string& s) {
 
 }  // namespace
 
-std::string goal_json(const ProgressiveResult& p, const std::optional<double>& target,
-                      const std::optional<double>& limit, std::uint64_t seed) {
+std::string goal_json(const GoalResult& p, const std::optional<double>& target,
+                      const std::optional<double>& limit) {
     std::ostringstream j;
     j << "  \"goal\": {\"target_error\": " << (target ? json_number(*target) : "null")
       << ", \"time_limit\": " << (limit ? json_number(*limit) : "null")
       << ", \"target_met\": " << json_bool(p.target_met)
       << ", \"combined\": " << json_bool(p.combined) << ", \"rounds\": [";
-    std::size_t full = 0;
     for (std::size_t i = 0; i < p.rounds.size(); ++i) {
-        const ProgressiveRound& r = p.rounds[i];
+        const GoalRound& r = p.rounds[i];
         j << (i ? ", " : "") << "{\"spp\": " << r.spp;
-        // A pilot of one pixel in b x b is not part of the image. A full round's seed renders it
-        // alone (--spp N --seed S): a string, as 64 bits are beyond a JSON number's exact range.
-        if (r.top_up()) {
-            // Its seed's pattern covers only some pixels: no plain render repeats it.
+        // A combined full round's seed renders it alone (--spp N --seed S): a string, as 64 bits
+        // are beyond a JSON number's exact range. A top-up's pattern covers only some pixels and
+        // a pilot is not part of the image: no plain render repeats them.
+        if (r.kind == RoundKind::kTopUp) {
             j << ", \"top_up_share\": " << json_number(r.top_up_share);
-            ++full;
-        } else if (!r.full()) {
+        } else if (r.kind == RoundKind::kPilot) {
             j << ", \"pilot_pixel_block\": " << r.pixel_block;
         } else if (p.combined) {
-            j << ", \"seed\": \"" << round_seed(seed, full++) << "\"";
+            j << ", \"seed\": \"" << r.seed << "\"";
         }
         j << ", \"seconds\": " << json_number(r.seconds)
           << ", \"estimated_rmse\": " << (r.error ? json_number(*r.error) : "null") << "}";
@@ -75,6 +73,9 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
     const RayCounts& rays = r.stats.rays;
     const Effects& e = r.plan.effects;
     const RenderSettings& s = scene.settings;
+    // The path integrator's keys appear only in its renders: a distributed render's JSON is as it
+    // was before that integrator existed.
+    const bool path = s.integrator == IntegratorKind::kPath;
     std::ostringstream j;
     j << std::setprecision(6);
     j << "{\n  \"scene\": " << json_string(scene.path) << ",\n"
@@ -94,8 +95,9 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
           << ", \"assemble\": " << json_number(r.stats.assemble_seconds / n * 1e6) << "},\n";
     }
     j << "  \"rays\": {\"camera\": " << rays.camera << ", \"shadow\": " << rays.shadow
-      << ", \"reflection\": " << rays.reflection << ", \"refraction\": " << rays.refraction
-      << ", \"diffuse\": " << rays.diffuse << ", \"total\": " << rays.total() << "},\n"
+      << ", \"reflection\": " << rays.reflection << ", \"refraction\": " << rays.refraction;
+    if (path) j << ", \"diffuse\": " << rays.diffuse;
+    j << ", \"total\": " << rays.total() << "},\n"
       << "  \"million_rays_per_second\": "
       << json_number(r.stats.seconds > 0 ? rays.total() / r.stats.seconds / 1e6 : 0.0) << ",\n"
       << "  \"mean_spp\": " << json_number(double(r.stats.samples) / (double(s.width) * s.height))
@@ -120,8 +122,9 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
       << ", \"glossy_reflection\": " << json_bool(e.glossy_reflection)
       << ", \"glossy_refraction\": " << json_bool(e.glossy_refraction)
       << ", \"depth_of_field\": " << json_bool(e.depth_of_field)
-      << ", \"motion_blur\": " << json_bool(e.motion_blur)
-      << ", \"indirect_light\": " << json_bool(e.indirect_light) << "}\n}";
+      << ", \"motion_blur\": " << json_bool(e.motion_blur);
+    if (path) j << ", \"indirect_light\": " << json_bool(e.indirect_light);
+    j << "}\n}";
     return j.str();
 }
 

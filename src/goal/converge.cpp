@@ -69,22 +69,24 @@ std::uint64_t reference_seed(std::uint64_t seed) {
     return seed + 1;
 }
 
-RenderResult render_with(Scene& scene, int spp, std::uint64_t seed, const RenderOptions& options) {
-    const SettingsGuard guard(scene);
-    scene.settings.samples = spp;
-    scene.settings.seed = seed;
-    return render(scene, options);
+RenderRequest request_at(int spp, std::uint64_t seed, const RenderOptions& options) {
+    RenderRequest request;
+    request.samples = spp;
+    request.seed = seed;
+    request.adaptive = options.adaptive;
+    return request;
 }
 
-Convergence measure_convergence(Scene& scene, const std::vector<int>& spps, const Image& reference,
-                                const RenderOptions& options,
+Convergence measure_convergence(const Scene& scene, const std::vector<int>& spps,
+                                const Image& reference, const RenderOptions& options,
                                 const std::function<void(const ConvergencePoint&)>& on_point) {
     require_same_size(Image(scene.settings.width, scene.settings.height), reference);
     Convergence c;
     const int largest = spps.empty() ? 1 : *std::max_element(spps.begin(), spps.end());
     for (const int spp : spps) {
         const std::clock_t cpu_start = std::clock();
-        const RenderResult r = render_with(scene, spp, scene.settings.seed, options);
+        const RenderResult r =
+            render(scene, request_at(spp, scene.settings.seed, options), options);
         ConvergencePoint p;
         p.spp = spp;
         p.seconds = r.stats.seconds;

@@ -1,15 +1,11 @@
 #include "drt/io/image.h"
 
-#include <fcntl.h>
 #include <stb_image.h>
 #include <stb_image_write.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <bit>
 #include <cctype>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -17,11 +13,12 @@
 #include <memory>
 #include <string>
 #include <string_view>
-#include <system_error>
 
 #include "drt/io/exr.h"
 #include "drt/util/atomic_file.h"
+#include "drt/util/file_reader.h"
 #include "drt/util/limits.h"
+#include "drt/util/little_endian.h"
 #include "drt/util/text.h"
 
 namespace drt {
@@ -42,10 +39,6 @@ constexpr int kMaxSide = 1 << 24;
 std::string too_many_pixels(int w, int h) {
     return "image of " + std::to_string(w) + "x" + std::to_string(h) +
            " pixels exceeds the limit of " + std::to_string(kMaxPixels) + " pixels";
-}
-
-std::string errno_text(int err) {
-    return std::generic_category().message(err);
 }
 
 // ---- encoding -------------------------------------------------------------------------------
@@ -70,12 +63,6 @@ Bytes encode_8bit(const Image& image, ImageFormat format, const fs::path& path) 
     return file;
 }
 
-void put_le32(Bytes& out, std::uint32_t v) {
-    for (int shift = 0; shift < 32; shift += 8) {
-        out.push_back(static_cast<unsigned char>(v >> shift));
-    }
-}
-
 // PFM stores rows bottom-up; a negative scale marks little-endian data, which we always write
 // so the bytes do not depend on the host.
 Bytes encode_pfm(const Image& image) {
@@ -87,7 +74,7 @@ Bytes encode_pfm(const Image& image) {
     for (int y = image.height - 1; y >= 0; --y) {
         const float* row = image.rgb.data() + y * row_floats;
         for (std::size_t i = 0; i < row_floats; ++i) {
-            put_le32(file, std::bit_cast<std::uint32_t>(row[i]));
+            append_little_endian(file, std::bit_cast<std::uint32_t>(row[i]), 4);
         }
     }
     return file;
@@ -95,49 +82,26 @@ Bytes encode_pfm(const Image& image) {
 
 // ---- decoding -------------------------------------------------------------------------------
 
-// Reads a whole regular file of at most kMaxImageFileBytes: a device, a pipe or a folder named
-// like an image is refused before reading, and a file that grows while read is cut off.
-Bytes read_file(const fs::path& path) {
-    struct Descriptor {
-        int fd;
-        ~Descriptor() {
-            if (fd >= 0) ::close(fd);
+// A device, a pipe or a folder named like an image is refused before reading.
+Bytes read_image_file(const fs::path& path) {
+    try {
+        return read_binary_file(path, kMaxImageFileBytes, FileKinds::regular_only);
+    } catch (const FileReadError& e) {
+        switch (e.problem()) {
+            case FileProblem::cannot_open:
+                fail(path, "cannot open file: " + e.reason());
+            case FileProblem::cannot_read:
+                fail(path, "cannot read file: " + e.reason());
+            case FileProblem::is_folder:
+                fail(path, "is a folder, not an image file");
+            case FileProblem::not_regular_file:
+                fail(path, "not a regular file");
+            case FileProblem::too_large:
+                break;
         }
-    } const file{::open(path.c_str(), O_RDONLY | O_CLOEXEC)};
-    const int fd = file.fd;
-    if (fd < 0) fail(path, "cannot open file: " + errno_text(errno));
-    struct stat info {};
-    if (::fstat(fd, &info) != 0) fail(path, "cannot open file: " + errno_text(errno));
-    if (!S_ISREG(info.st_mode)) {
-        fail(path, S_ISDIR(info.st_mode) ? "is a folder, not an image file" : "not a regular file");
-    }
-    const auto too_large = [&] {
         fail(path, "file larger than the " + std::to_string(kMaxImageFileBytes >> 20) +
                        " MiB limit for an image");
-    };
-    if (static_cast<std::uint64_t>(info.st_size) > kMaxImageFileBytes) too_large();
-    Bytes data(static_cast<std::size_t>(info.st_size));
-    std::size_t done = 0;
-    for (;;) {
-        if (done == data.size()) {
-            if (data.size() >= kMaxImageFileBytes) {
-                // At the limit: one more byte means too large.
-                unsigned char extra = 0;
-                const ssize_t n = ::read(fd, &extra, 1);
-                if (n < 0 && errno == EINTR) continue;
-                if (n > 0) too_large();
-                break;
-            }
-            data.resize(std::min<std::uint64_t>(kMaxImageFileBytes, 2 * data.size() + 65536));
-        }
-        const ssize_t n = ::read(fd, data.data() + done, data.size() - done);
-        if (n < 0 && errno == EINTR) continue;
-        if (n < 0) fail(path, "cannot read file: " + errno_text(errno));
-        if (n == 0) break;
-        done += static_cast<std::size_t>(n);
     }
-    data.resize(done);
-    return data;
 }
 
 bool starts_with(const Bytes& data, std::string_view magic) {
@@ -309,7 +273,7 @@ void write_image(const Image& image, const fs::path& path, const ImageWriteOptio
 
 Image read_image(const fs::path& path) {
     const ImageFormat format = format_for_path(path);
-    const Bytes data = read_file(path);
+    const Bytes data = read_image_file(path);
     switch (format) {
         case ImageFormat::kPfm:
             return decode_pfm(data, path);

@@ -1,19 +1,13 @@
 // The OBJ reader. It is drt's own rather than tinyobjloader's, because tinyobjloader reads
 // "abc", "nan" and "inf" as 0, keeps a face whose index is out of range with a warning that
-// names no line, and accepts "3x" as 3 — all of which the scene format calls errors
-// (README.md, Dependencies).
+// names no line, and accepts "3x" as 3 — all of which the scene format calls errors.
 #include "drt/io/obj_reader.h"
 
-#include <sys/stat.h>
-
-#include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
-#include <memory>
-#include <system_error>
+#include <string>
 
-#include "drt/util/huge_pages.h"
+#include "drt/util/file_reader.h"
 #include "drt/util/limits.h"
 #include "drt/util/text.h"
 
@@ -187,36 +181,15 @@ class ObjParser {
 };
 
 std::string read_text(const std::filesystem::path& path) {
-    const auto cannot_open = [](int error) {
-        return ObjOpenError(std::error_code(error, std::generic_category()).message());
-    };
-    const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
-                                                               &std::fclose);
-    if (!file) throw cannot_open(errno);
-    const auto too_large = [&] {
-        return ObjError(printable(path.string()) + ": file larger than the " +
-                        std::to_string(kMaxObjBytes >> 20) + " MiB limit for a mesh");
-    };
-    // A regular file's size is known before reading; an endless input (/dev/zero) is caught as
-    // it is read.
-    struct stat info {};
-    std::string contents;
-    if (::fstat(::fileno(file.get()), &info) == 0 && S_ISREG(info.st_mode)) {
-        const auto size = static_cast<std::uint64_t>(info.st_size);
-        if (size > kMaxObjBytes) throw too_large();
-        // Room for the whole file at once: growing by doubling would copy it and hold it twice.
-        contents.reserve(size);
-        prefer_huge_pages(contents.data(), contents.capacity());
+    try {
+        return read_text_file(path, kMaxObjBytes);
+    } catch (const FileReadError& e) {
+        if (e.problem() == FileProblem::too_large) {
+            throw ObjError(printable(path.string()) + ": file larger than the " +
+                           std::to_string(kMaxObjBytes >> 20) + " MiB limit for a mesh");
+        }
+        throw ObjOpenError(e.reason());
     }
-    char buffer[1 << 16];
-    std::size_t n = 0;
-    while ((n = std::fread(buffer, 1, sizeof buffer, file.get())) > 0) {
-        if (contents.size() + n > kMaxObjBytes) throw too_large();
-        contents.append(buffer, n);
-    }
-    // A directory opens fine on Linux and fails only when read (EISDIR).
-    if (std::ferror(file.get())) throw cannot_open(errno);
-    return contents;
 }
 
 }  // namespace

@@ -2,12 +2,15 @@
 
 #include <bit>
 #include <cstring>
-#include <fstream>
 #include <iterator>
 #include <sstream>
 #include <system_error>
 
+#include "drt/job/tile_codec.h"
 #include "drt/util/atomic_file.h"
+#include "drt/util/file_reader.h"
+#include "drt/util/limits.h"
+#include "drt/util/little_endian.h"
 #include "drt/util/rng.h"
 #include "drt/util/text.h"
 
@@ -19,12 +22,16 @@ namespace {
 
 using Bytes = std::vector<unsigned char>;
 
-// "DRTCKPT" and a format number: a reader refuses a format it does not know instead of guessing.
-// Format 2 added each pixel's spread and each tile's error sums (error_estimate.h); format 3
-// fingerprints each file the scene reads on its own (format 2 had one hash for them all); format 4
-// holds the error sums of the estimate's calibration instead of sobol's run spreads; format 5
-// counts each tile's diffuse rays (the path integrator's).
-constexpr char kMagic[8] = {'D', 'R', 'T', 'C', 'K', 'P', 'T', '5'};
+// "DRTCKPT" and a format number, raised whenever the layout changes (the tile codec's included):
+// a reader refuses a format it does not know instead of guessing. Format 5 is format 4 with each
+// tile's diffuse ray count (DiffuseCount::kCarried): a path render's; a distributed render writes
+// format 4.
+constexpr char kMagic[8] = {'D', 'R', 'T', 'C', 'K', 'P', 'T', '4'};
+constexpr char kFormatWithoutDiffuse = '4', kFormatWithDiffuse = '5';
+
+char format_of(DiffuseCount diffuse) {
+    return diffuse == DiffuseCount::kCarried ? kFormatWithDiffuse : kFormatWithoutDiffuse;
+}
 // The longest version string a reader accepts, so a damaged length cannot ask for gigabytes.
 constexpr std::uint32_t kMaxVersionLength = 256;
 // Likewise for a file's name (PATH_MAX on Linux).
@@ -36,38 +43,13 @@ constexpr std::uint32_t kMaxNameLength = 4096;
 
 class Writer {
   public:
-    void u32(std::uint32_t v) { put(v, 4); }
-    void u64(std::uint64_t v) { put(v, 8); }
-    void f32(float v) { u32(std::bit_cast<std::uint32_t>(v)); }
-    void f64(double v) { u64(std::bit_cast<std::uint64_t>(v)); }
+    void u32(std::uint32_t v) { append_little_endian(bytes, v, 4); }
+    void u64(std::uint64_t v) { append_little_endian(bytes, v, 8); }
     void text(const std::string& s) {
         u32(static_cast<std::uint32_t>(s.size()));
         bytes.insert(bytes.end(), s.begin(), s.end());
     }
-    void tile(const TileBuffer& t) {
-        u64(t.tile.index);
-        for (float v : t.pixels.rgb) f32(v);
-        for (std::uint32_t n : t.pixel_samples) u32(n);
-        for (float v : t.spread.rgb) f32(v);
-        f64(t.error_sums.variance);
-        f64(t.error_sums.spread);
-        f64(t.error_sums.pixels);
-        f64(t.error_sums.samples);
-        u64(t.rays.camera);
-        u64(t.rays.shadow);
-        u64(t.rays.reflection);
-        u64(t.rays.refraction);
-        u64(t.rays.diffuse);
-        u64(t.samples);
-        u64(t.converged);
-    }
     Bytes bytes;
-
-  private:
-    // Little-endian whatever the host, so a checkpoint moves between machines.
-    void put(std::uint64_t v, int size) {
-        for (int i = 0; i < size; ++i) bytes.push_back(static_cast<unsigned char>(v >> (8 * i)));
-    }
 };
 
 class Reader {
@@ -76,8 +58,6 @@ class Reader {
         : bytes_(bytes), file_(file) {}
     std::uint32_t u32() { return static_cast<std::uint32_t>(get(4)); }
     std::uint64_t u64() { return get(8); }
-    float f32() { return std::bit_cast<float>(u32()); }
-    double f64() { return std::bit_cast<double>(u64()); }
     std::string text(std::uint32_t max) {
         const std::uint32_t n = u32();
         if (n > max) fail(file_, "damaged checkpoint (bad text length)");
@@ -87,32 +67,17 @@ class Reader {
         return s;
     }
     // A tile of `grid`, not one of those marked in `seen`, which it then marks.
-    TileBuffer tile(std::span<const Tile> grid, std::vector<bool>& seen) {
-        const std::uint64_t index = u64();
-        if (index >= grid.size() || seen[index]) fail(file_, "damaged checkpoint (bad tile index)");
-        seen[index] = true;
-        TileBuffer t;
-        t.tile = grid[index];
-        t.pixels = Image(t.tile.width(), t.tile.height());
-        need(t.pixels.rgb.size() * 4);
-        for (float& v : t.pixels.rgb) v = f32();
-        t.pixel_samples.resize(static_cast<std::size_t>(t.tile.width()) * t.tile.height());
-        for (std::uint32_t& n : t.pixel_samples) n = u32();
-        t.spread = Image(t.tile.width(), t.tile.height());
-        need(t.spread.rgb.size() * 4);
-        for (float& v : t.spread.rgb) v = f32();
-        t.error_sums.variance = f64();
-        t.error_sums.spread = f64();
-        t.error_sums.pixels = f64();
-        t.error_sums.samples = f64();
-        t.rays.camera = u64();
-        t.rays.shadow = u64();
-        t.rays.reflection = u64();
-        t.rays.refraction = u64();
-        t.rays.diffuse = u64();
-        t.samples = u64();
-        t.converged = u64();
-        return t;
+    TileBuffer tile(std::span<const Tile> grid, std::vector<bool>& seen, DiffuseCount diffuse) {
+        std::span<const unsigned char> rest = bytes_.subspan(pos_);
+        try {
+            TileBuffer t = take_tile(rest, grid, seen, diffuse);
+            pos_ = bytes_.size() - rest.size();
+            return t;
+        } catch (const TileCodecError& e) {
+            if (e.problem() == TileCodecError::Problem::truncated)
+                fail(file_, "truncated checkpoint");
+            fail(file_, "damaged checkpoint (bad tile index)");
+        }
     }
     std::size_t left() const { return bytes_.size() - pos_; }
 
@@ -122,8 +87,7 @@ class Reader {
     }
     std::uint64_t get(int size) {
         need(static_cast<std::size_t>(size));
-        std::uint64_t v = 0;
-        for (int i = 0; i < size; ++i) v |= std::uint64_t{bytes_[pos_ + i]} << (8 * i);
+        const std::uint64_t v = read_little_endian(bytes_.data() + pos_, size);
         pos_ += static_cast<std::size_t>(size);
         return v;
     }
@@ -138,12 +102,22 @@ std::string printable_format(unsigned char c) {
     return "byte " + std::to_string(c);
 }
 
+// A checkpoint of the largest image the limits allow fits the memory budget, as do the scene and
+// mesh files whose fingerprints it holds.
 Bytes read_all(const fs::path& file) {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) fail(file, "cannot open file: " + std::generic_category().message(errno));
-    Bytes data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) fail(file, "cannot read file");
-    return data;
+    try {
+        return read_binary_file(file, kMemoryBudget);
+    } catch (const FileReadError& e) {
+        switch (e.problem()) {
+            case FileProblem::cannot_open:
+                fail(file, "cannot open file: " + e.reason());
+            case FileProblem::too_large:
+                fail(file,
+                     "file larger than the " + std::to_string(kMemoryBudget >> 20) + " MiB limit");
+            default:
+                fail(file, "cannot read file");
+        }
+    }
 }
 
 // What differs between the files a checkpoint's render read (`got`) and this render's.
@@ -212,13 +186,14 @@ RenderIdentity identify_render(std::span<const fs::path> files, const RenderSett
     id.width = settings.width;
     id.height = settings.height;
     id.tiles = tiles;
+    id.diffuse = diffuse_count_for(settings);
     return id;
 }
 
 std::vector<unsigned char> encode_checkpoint(const RenderIdentity& id,
                                              std::span<const TileBuffer> tiles) {
-    Writer w;
-    w.bytes.insert(w.bytes.end(), std::begin(kMagic), std::end(kMagic));
+    Writer w{Bytes(std::begin(kMagic), std::end(kMagic))};
+    w.bytes.back() = static_cast<unsigned char>(format_of(id.diffuse));
     w.text(id.version);
     w.u64(id.files.size());
     for (const FileFingerprint& f : id.files) {
@@ -230,20 +205,20 @@ std::vector<unsigned char> encode_checkpoint(const RenderIdentity& id,
     w.u32(static_cast<std::uint32_t>(id.height));
     w.u64(id.tiles);
     w.u64(tiles.size());
-    for (const TileBuffer& t : tiles) w.tile(t);
+    for (const TileBuffer& t : tiles) append_tile(w.bytes, t, id.diffuse);
     w.u64(hash_bytes(w.bytes));
     return std::move(w.bytes);
 }
 
 Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<const Tile> grid,
-                             const fs::path& file) {
+                             const fs::path& file, DiffuseCount expected) {
     if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic - 1) != 0) {
         fail(file, "not a drt checkpoint");
     }
-    if (bytes[sizeof kMagic - 1] != static_cast<unsigned char>(kMagic[sizeof kMagic - 1])) {
-        fail(file, std::string("checkpoint format ") + printable_format(bytes[sizeof kMagic - 1]) +
-                       " of another drt version, this one reads format " +
-                       kMagic[sizeof kMagic - 1] +
+    const unsigned char format = bytes[sizeof kMagic - 1];
+    if (format != kFormatWithoutDiffuse && format != kFormatWithDiffuse) {
+        fail(file, std::string("checkpoint format ") + printable_format(format) +
+                       " of another drt version, this one reads format " + format_of(expected) +
                        ": not resumed and nothing written (delete it or name another "
                        "--checkpoint file)");
     }
@@ -256,6 +231,7 @@ Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<con
     Reader r(body.subspan(sizeof kMagic), file);
     Checkpoint c;
     RenderIdentity& id = c.identity;
+    id.diffuse = format == kFormatWithDiffuse ? DiffuseCount::kCarried : DiffuseCount::kOmitted;
     id.version = r.text(kMaxVersionLength);
     const std::uint64_t files = r.u64();
     // Each takes at least 12 bytes, so a damaged count soon runs out of file.
@@ -272,7 +248,7 @@ Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<con
     const std::uint64_t count = r.u64();
     if (count > grid.size()) fail(file, "damaged checkpoint (more tiles than the image has)");
     std::vector<bool> seen(grid.size(), false);
-    for (std::uint64_t i = 0; i < count; ++i) c.tiles.push_back(r.tile(grid, seen));
+    for (std::uint64_t i = 0; i < count; ++i) c.tiles.push_back(r.tile(grid, seen, id.diffuse));
     if (r.left() != 0) fail(file, "damaged checkpoint (bytes after the last tile)");
     return c;
 }
@@ -284,13 +260,15 @@ std::optional<Checkpoint> read_checkpoint(const fs::path& file, const RenderIden
     if (status.type() == fs::file_type::not_found) return std::nullopt;
     if (ec) fail(file, "cannot examine file: " + ec.message());
     if (status.type() != fs::file_type::regular) fail(file, "not a regular file");
-    Checkpoint c = decode_checkpoint(read_all(file), grid, file);
+    Checkpoint c = decode_checkpoint(read_all(file), grid, file, expected.diffuse);
     const RenderIdentity& got = c.identity;
     std::string differs;
     if (got.version != expected.version) {
         differs = "drt " + got.version + ", not drt " + expected.version;
     } else if (got.files != expected.files) {
         differs = files_differing(got.files, expected.files);
+    } else if (got.diffuse != expected.diffuse) {
+        differs = "the other integrator (its format counts diffuse rays differently)";
     } else if (got.width != expected.width || got.height != expected.height) {
         differs = "another image size (" + std::to_string(got.width) + "x" +
                   std::to_string(got.height) + ")";
@@ -303,21 +281,6 @@ std::optional<Checkpoint> read_checkpoint(const fs::path& file, const RenderIden
                        "--checkpoint file)");
     }
     return c;
-}
-
-std::vector<unsigned char> encode_tile(const TileBuffer& tile) {
-    Writer w;
-    w.tile(tile);
-    return std::move(w.bytes);
-}
-
-TileBuffer decode_tile(std::span<const unsigned char> bytes, std::span<const Tile> grid,
-                       const fs::path& source) {
-    Reader r(bytes, source);
-    std::vector<bool> seen(grid.size(), false);
-    TileBuffer t = r.tile(grid, seen);
-    if (r.left() != 0) fail(source, "damaged tile (bytes after its end)");
-    return t;
 }
 
 CheckpointSink::CheckpointSink(TileSink& next, fs::path file, RenderIdentity identity,

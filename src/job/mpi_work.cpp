@@ -19,7 +19,7 @@
 #include <thread>
 #include <vector>
 
-#include "drt/job/checkpoint.h"
+#include "drt/job/tile_codec.h"
 #include "drt/util/limits.h"
 
 namespace drt {
@@ -66,7 +66,7 @@ enum Tag : int {
     kGrant,        // from the leader: tile indices; none means there is no more work
     kResult,       // to the leader: one finished tile (encode_tile)
     kDone,         // to the leader: tile indices handed out but not rendered; nothing follows
-    kShared,       // from the leader, between renders: 32-bit values (MpiJob::leaders)
+    kShared,       // from the leader, between renders: 32-bit values (MpiJob::broadcast)
 };
 
 // How long a communication thread sleeps while it waits for a message: at first short against
@@ -187,6 +187,17 @@ int receive_int(const Transport& transport, int from, int tag) {
     return value;
 }
 
+// A finished tile from process `from`; a damaged message is a failure of the job's transport.
+TileBuffer received_tile(std::span<const unsigned char> bytes, const RenderContext& context,
+                         int from) {
+    try {
+        return decode_tile(bytes, context.tiles(), diffuse_count_for(context.scene().settings));
+    } catch (const TileCodecError& e) {
+        throw std::runtime_error("MPI: a tile message from process " + std::to_string(from) + ": " +
+                                 e.what());
+    }
+}
+
 // The leader's tiles not handed out yet, shared by its own workers and the processes it serves.
 class LeaderQueue final : public TileSource {
   public:
@@ -276,8 +287,7 @@ void serve(const Transport& transport, const RenderContext& context, LeaderQueue
                 if (error) break;  // drain the others, but add nothing more
                 const Clock::time_point received = Clock::now();
                 try {
-                    sink.add(
-                        decode_tile(bytes, context.tiles(), "process " + std::to_string(from)));
+                    sink.add(received_tile(bytes, context, from));
                 } catch (...) {
                     error = std::current_exception();
                     queue.close();
@@ -354,10 +364,10 @@ class WorkerQueue final : public TileSource {
 // Finished tiles of another process, encoded, waiting to be sent by its communication thread.
 class Outbox final : public TileSink {
   public:
-    explicit Outbox(Doorbell& added) : added_(added) {}
+    Outbox(Doorbell& added, DiffuseCount diffuse) : added_(added), diffuse_(diffuse) {}
 
     void add(TileBuffer buffer) override {
-        std::vector<unsigned char> bytes = encode_tile(buffer);
+        std::vector<unsigned char> bytes = encode_tile(buffer, diffuse_);
         {
             const std::lock_guard lock(mutex_);
             messages_.push_back(std::move(bytes));
@@ -376,6 +386,7 @@ class Outbox final : public TileSink {
     std::mutex mutex_;
     std::deque<std::vector<unsigned char> > messages_;
     Doorbell& added_;
+    DiffuseCount diffuse_;
 };
 
 // Another process's communication thread: keeps `threads` tiles ahead of its workers, sends
@@ -463,11 +474,11 @@ MpiJob::MpiJob() {
 
 MpiJob::~MpiJob() = default;
 
-int MpiJob::leaders(int value) const {
-    return transport_->leaders(value);
+int MpiJob::broadcast(int value) const {
+    return transport_->broadcast(value);
 }
 
-std::vector<std::uint32_t> MpiJob::leaders(std::vector<std::uint32_t> values) const {
+std::vector<std::uint32_t> MpiJob::broadcast(std::vector<std::uint32_t> values) const {
     if (leader()) {
         std::vector<unsigned char> bytes(values.size() * sizeof(std::uint32_t));
         if (!values.empty()) std::memcpy(bytes.data(), values.data(), bytes.size());
@@ -488,8 +499,9 @@ int MpiJob::highest(int value) const {
     return transport_->highest(value);
 }
 
-MpiShare MpiJob::render(const RenderContext& context, std::vector<Tile> todo, TileSink& sink,
-                        const RenderOptions& options) const {
+MpiShare MpiJob::render_tiles(const RenderContext& context, const RenderRequest& request,
+                              std::vector<Tile> todo, TileSink& sink,
+                              const RenderOptions& options) const {
     RenderOptions run = options;
     if (run.threads <= 0) run.threads = share_of_machine(local_size());
     if (leader()) {
@@ -499,7 +511,7 @@ MpiShare MpiJob::render(const RenderContext& context, std::vector<Tile> todo, Ti
         std::jthread server([&] { serve(*transport_, context, queue, sink, share, served_error); });
         std::exception_ptr error;
         try {
-            share.threads = render_tiles(context, queue, sink, run);
+            share.threads = drt::render_tiles(context, request, queue, sink, run);
         } catch (...) {
             error = std::current_exception();
             queue.close();
@@ -510,7 +522,7 @@ MpiShare MpiJob::render(const RenderContext& context, std::vector<Tile> todo, Ti
         // Tiles given back by a process that stopped on its own, after the leader's workers
         // had run dry: everyone else has finished, so they are rendered here.
         if (!queue.empty() && !options.stop.stop_requested()) {
-            render_tiles(context, queue, sink, run);
+            drt::render_tiles(context, request, queue, sink, run);
         }
         share.emptied = queue.emptied();
         return share;
@@ -518,7 +530,7 @@ MpiShare MpiJob::render(const RenderContext& context, std::vector<Tile> todo, Ti
     run.on_progress = nullptr;
     Doorbell doorbell;
     WorkerQueue queue(context.tiles().size(), options.stop, doorbell);
-    Outbox outbox(doorbell);
+    Outbox outbox(doorbell, diffuse_count_for(context.scene().settings));
     std::atomic<bool> workers_finished{false};
     std::jthread communicator([&] {
         work_for_leader(*transport_, context, queue, outbox, run.threads, workers_finished,
@@ -527,7 +539,7 @@ MpiShare MpiJob::render(const RenderContext& context, std::vector<Tile> todo, Ti
     MpiShare share;
     std::exception_ptr error;
     try {
-        share.threads = render_tiles(context, queue, outbox, run);
+        share.threads = drt::render_tiles(context, request, queue, outbox, run);
     } catch (...) {
         error = std::current_exception();
     }

@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <stdexcept>
 #include <string>
 
 #include "drt/job/checkpoint.h"
@@ -33,45 +34,91 @@ class StopAfter final : public TileSink {
     std::stop_source stop_;
 };
 
-}  // namespace
+using Clock = std::chrono::steady_clock;
 
-RenderJobResult run_render_job(const Scene& scene, const RenderJobOptions& options) {
-    const auto start = std::chrono::steady_clock::now();
-    const RenderContext context(scene, options.adaptive,
-                                options.estimate_error || options.checkpoint.has_value(),
-                                options.pixel_block, options.top_up);
+double seconds_between(Clock::time_point from, Clock::time_point to) {
+    return std::chrono::duration<double>(to - from).count();
+}
+
+// Opens the leader's checkpoint of `request` into `kept`, its resumed tiles added to `image`.
+// A refusal is agreed by every process: then all throw CheckpointError.
+void open_checkpoint(const RenderContext& context, const RenderRequest& request,
+                     const RenderJobOptions& options, bool leader, ImageSink* image,
+                     std::optional<CheckpointSink>& kept, std::size_t& resumed_tiles) {
+    if (!options.checkpoint) return;
+    const RenderSettings& settings = context.scene().settings;
+    if (request.pixels != PixelChoice::kAll || request.paired ||
+        request.samples != settings.samples || request.seed != settings.seed) {
+        throw std::invalid_argument("a checkpoint of a request other than the scene's image");
+    }
+    std::string refused;
+    if (leader) {
+        try {
+            const RenderIdentity id = identify_render(
+                options.scene_files, settings, request.applied_adaptive(), context.tiles().size());
+            try {
+                check_replaceable(*options.checkpoint);
+            } catch (const FileWriteError& e) {
+                throw CheckpointError(e.what());
+            }
+            std::optional<Checkpoint> resumed =
+                read_checkpoint(*options.checkpoint, id, context.tiles());
+            if (resumed) resumed_tiles = resumed->tiles.size();
+            kept.emplace(*image, *options.checkpoint, id, options.checkpoint_interval,
+                         resumed ? std::move(resumed->tiles) : std::vector<TileBuffer>{});
+        } catch (const CheckpointError& e) {
+            refused = e.what();
+        }
+    }
+    const bool refuse =
+        options.mpi ? options.mpi->broadcast(refused.empty() ? 0 : 1) != 0 : !refused.empty();
+    if (refuse) throw CheckpointError(leader ? refused : "the leader refused the checkpoint");
+}
+
+// Renders `todo` into `into` (the leader's; absent elsewhere) across the job's processes.
+MpiShare render_share(const RenderContext& context, const RenderRequest& request,
+                      std::vector<Tile> todo, TileSink* into, const RenderOptions& run,
+                      const MpiJob* mpi) {
+    if (mpi) {
+        // Elsewhere than on the leader, tiles go to the leader instead of a sink.
+        ImageSink unused(0, 0, {});
+        return mpi->render_tiles(context, request, std::move(todo), into ? *into : unused, run);
+    }
+    MpiShare share;
+    TileQueue queue(std::move(todo));
+    share.threads = render_tiles(context, request, queue, *into, run);
+    share.emptied = queue.emptied();
+    return share;
+}
+
+// The leader's figures of how the job's processes shared the tiles, `finished` when they had.
+void add_share(RenderStats& stats, const MpiShare& share, Clock::time_point finished,
+               const MpiJob* mpi) {
+    stats.threads = share.threads;
+    if (share.emptied) stats.tail_seconds = seconds_between(*share.emptied, finished);
+    stats.tile_messages = share.messages;
+    stats.receive_seconds = share.receive_seconds;
+    stats.assemble_seconds = share.assemble_seconds;
+    stats.processes = mpi ? mpi->size() : 1;
+}
+
+RenderJobResult run_job(const RenderContext& context, const RenderRequest& asked,
+                        const RenderJobOptions& options, Clock::time_point start) {
+    // A checkpoint keeps the estimate's sums: a render with one always estimates.
+    RenderRequest request = asked;
+    request.estimate_error = request.estimate_error || options.checkpoint.has_value();
+    context.check(request);
+    const Scene& scene = context.scene();
     const bool leader = options.mpi == nullptr || options.mpi->leader();
     RenderJobResult out;
     out.tiles = context.tiles().size();
 
     // Only the leader assembles the image and keeps the checkpoint.
     std::optional<ImageSink> image;
+    if (leader) image.emplace(scene.settings.width, scene.settings.height, context.tiles());
     std::optional<CheckpointSink> kept;
-    std::string refused;
-    if (leader) {
-        image.emplace(scene.settings.width, scene.settings.height, context.tiles());
-        if (options.checkpoint) {
-            try {
-                const RenderIdentity id = identify_render(options.scene_files, scene.settings,
-                                                          context.adaptive(), out.tiles);
-                try {
-                    check_replaceable(*options.checkpoint);
-                } catch (const FileWriteError& e) {
-                    throw CheckpointError(e.what());
-                }
-                std::optional<Checkpoint> resumed =
-                    read_checkpoint(*options.checkpoint, id, context.tiles());
-                if (resumed) out.resumed = resumed->tiles.size();
-                kept.emplace(*image, *options.checkpoint, id, options.checkpoint_interval,
-                             resumed ? std::move(resumed->tiles) : std::vector<TileBuffer>{});
-            } catch (const CheckpointError& e) {
-                refused = e.what();
-            }
-        }
-    }
-    const bool refuse =
-        options.mpi ? options.mpi->leaders(refused.empty() ? 0 : 1) != 0 : !refused.empty();
-    if (refuse) throw CheckpointError(leader ? refused : "the leader refused the checkpoint");
+    open_checkpoint(context, request, options, leader, image ? &*image : nullptr, kept,
+                    out.resumed);
 
     std::stop_source stopper;
     const std::stop_callback relay(options.stop, [&] { stopper.request_stop(); });
@@ -96,41 +143,38 @@ RenderJobResult run_render_job(const Scene& scene, const RenderJobOptions& optio
     }
     if (leader && options.costly_first) {
         const int threads = worker_threads(run.threads);
-        todo = costly_first(context, std::move(todo),
+        todo = costly_first(context, request, std::move(todo),
                             threads * (options.mpi ? options.mpi->size() : 1), threads);
     }
-    const auto tiles_start = std::chrono::steady_clock::now();
-    MpiShare share;
-    if (options.mpi) {
-        // Elsewhere than on the leader, tiles go to the leader instead of a sink.
-        ImageSink unused(0, 0, {});
-        share = options.mpi->render(context, std::move(todo), into ? *into : unused, run);
-    } else {
-        TileQueue queue(std::move(todo));
-        share.threads = render_tiles(context, queue, *into, run);
-        share.emptied = queue.emptied();
-    }
-    const auto finished = std::chrono::steady_clock::now();
+    const auto tiles_start = Clock::now();
+    const MpiShare share = render_share(context, request, std::move(todo), into, run, options.mpi);
+    const auto finished = Clock::now();
     if (!leader) {
         out.done = out.tiles;
         return out;
     }
-    out.render = assembled(context, *image);
+    out.render = assembled(context, request, *image);
     out.done = image->tiles_done();
     RenderStats& stats = out.render.stats;
-    stats.threads = share.threads;
-    if (share.emptied) {
-        stats.tail_seconds = std::chrono::duration<double>(finished - *share.emptied).count();
-    }
-    stats.tile_messages = share.messages;
-    stats.receive_seconds = share.receive_seconds;
-    stats.assemble_seconds = share.assemble_seconds;
-    stats.processes = options.mpi ? options.mpi->size() : 1;
+    add_share(stats, share, finished, options.mpi);
     if (kept && !out.complete()) kept->write();
-    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    stats.setup_seconds =
-        stats.seconds - std::chrono::duration<double>(finished - tiles_start).count();
+    stats.seconds = seconds_between(start, Clock::now());
+    stats.setup_seconds = stats.seconds - seconds_between(tiles_start, finished);
     return out;
+}
+
+}  // namespace
+
+RenderJobResult run_render_job(const Scene& scene, const RenderRequest& request,
+                               const RenderJobOptions& options) {
+    const auto start = Clock::now();
+    const RenderContext context(scene);
+    return run_job(context, request, options, start);
+}
+
+RenderJobResult run_render_job(const RenderContext& context, const RenderRequest& request,
+                               const RenderJobOptions& options) {
+    return run_job(context, request, options, Clock::now());
 }
 
 }  // namespace drt

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <iomanip>
 #include <limits>
+#include <span>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -91,39 +92,44 @@ double calibration_share(double pixels) {
                                   std::min(kCalibrationShare, kMaxCalibrationPixels / n)));
 }
 
+std::vector<double> largest_around(std::span<const double> values, int width, int height,
+                                   Around which) {
+    std::vector<double> out(std::size_t(width) * std::size_t(height), 0.0);
+    for (int y = 0; y < height; ++y) {
+        for (int x = 0; x < width; ++x) {
+            double most = 0;
+            for (int ny = std::max(0, y - 1); ny <= std::min(height - 1, y + 1); ++ny) {
+                for (int nx = std::max(0, x - 1); nx <= std::min(width - 1, x + 1); ++nx) {
+                    if (which == Around::kWithSelf || nx != x || ny != y) {
+                        most = std::max(most, values[std::size_t(ny) * width + nx]);
+                    }
+                }
+            }
+            out[std::size_t(y) * width + x] = most;
+        }
+    }
+    return out;
+}
+
+double pick_odds(double scale, double even, double weight, double total) {
+    constexpr double kEven = 0.25;
+    return std::min(1.0, scale * (kEven * even + (1 - kEven) * weight / total));
+}
+
 std::vector<double> calibration_odds(const Image& spread, double share) {
-    constexpr double kShared = 0.25;
-    const int w = spread.width, h = spread.height;
-    const std::size_t pixels = std::size_t(w) * h;
+    const std::size_t pixels = std::size_t(spread.width) * spread.height;
     std::vector<double> own(pixels);
     for (std::size_t i = 0; i < pixels; ++i) {
         own[i] = double(spread.rgb[3 * i]) + spread.rgb[3 * i + 1] + spread.rgb[3 * i + 2];
     }
-    // The largest spread of the pixel and its neighbours: a pixel whose few samples all fell on
-    // one side of an edge shows no spread, though its neighbours along the edge do, and with
-    // odds by its own spread alone it was rarely rendered twice and then weighed 1 / odds in
-    // the sums: one such pixel made 83 % of the calibration's variance sum (soft-shadow-one-
-    // light, 48 x 36, sobol 4 spp, seed 14: estimate 2.3x the true error).
-    std::vector<double> spreads(pixels);
+    const std::vector<double> spreads =
+        largest_around(own, spread.width, spread.height, Around::kWithSelf);
     double total = 0;
-    for (int y = 0; y < h; ++y) {
-        for (int x = 0; x < w; ++x) {
-            double most = 0;
-            for (int ny = std::max(0, y - 1); ny <= std::min(h - 1, y + 1); ++ny) {
-                for (int nx = std::max(0, x - 1); nx <= std::min(w - 1, x + 1); ++nx) {
-                    most = std::max(most, own[std::size_t(ny) * w + nx]);
-                }
-            }
-            spreads[std::size_t(y) * w + x] = most;
-            total += most;
-        }
-    }
+    for (const double s : spreads) total += s;
     std::vector<double> odds(pixels, share);
     if (!(total > 0) || !std::isfinite(total)) return odds;
     const double mean = total / double(pixels);
-    for (std::size_t i = 0; i < pixels; ++i) {
-        odds[i] = std::min(1.0, share * (kShared + (1 - kShared) * spreads[i] / mean));
-    }
+    for (std::size_t i = 0; i < pixels; ++i) odds[i] = pick_odds(share, 1.0, spreads[i], mean);
     return odds;
 }
 

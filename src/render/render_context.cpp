@@ -20,11 +20,11 @@ namespace drt {
 namespace {
 
 // The standard error of the mean of a pixel's sample values. Independent samples: the sample
-// deviation over sqrt(n). A progressive sampler's samples split into 8 consecutive runs that are
+// deviation over sqrt(n). An extensible sampler's samples split into 8 consecutive runs that are
 // each a stratified pattern of their own, so the spread of the 8 run means over sqrt(8) measures
 // the error stratification leaves; the spread of single samples would overstate it at every edge
 // (by n^(1/4) for an edge, whose stratified error falls as n^(-3/4)).
-double standard_error(std::span<const double> v, bool progressive) {
+double standard_error(std::span<const double> v, bool extensible) {
     constexpr std::size_t kRuns = 8;
     const std::size_t n = v.size();
     if (n < 2) return std::numeric_limits<double>::infinity();
@@ -37,7 +37,7 @@ double standard_error(std::span<const double> v, bool progressive) {
         }
         return m2 / double(x.size() - 1);
     };
-    if (!progressive || n < 2 * kRuns) return std::sqrt(spread(v) / double(n));
+    if (!extensible || n < 2 * kRuns) return std::sqrt(spread(v) / double(n));
     std::array<double, kRuns> means{};
     for (std::size_t g = 0; g < kRuns; ++g) {
         const std::size_t begin = g * n / kRuns, end = (g + 1) * n / kRuns;
@@ -53,99 +53,131 @@ std::unique_ptr<Sampler> sampler_named(const std::string& name) {
     return sampler;
 }
 
-}  // namespace
-
-RenderContext::RenderContext(const Scene& scene, std::optional<AdaptiveSampling> adaptive,
-                             bool estimate_error, int pixel_block,
-                             std::span<const std::uint32_t> top_up)
-    : scene_(scene),
-      sampler_(sampler_named(scene.settings.sampler)),
-      plan_(plan_render(scene)),
-      bvh_(scene.objects),
-      integrator_(make_integrator(scene, plan_, bvh_, *sampler_)),
-      adaptive_(adaptive),
-      estimate_error_(estimate_error),
-      pixel_block_(std::max(1, pixel_block)),
-      tiles_(tile_grid(scene.settings.width, scene.settings.height)) {
-    if (adaptive_) {
-        adaptive_->min_samples = std::clamp(adaptive_->min_samples, 1, scene.settings.samples);
-    }
-    // A plain render (block 1) counts every pixel at once; a pilot takes one hash a square.
-    const auto width = static_cast<std::uint64_t>(scene.settings.width);
-    const auto height = static_cast<std::uint64_t>(scene.settings.height);
-    const auto b = static_cast<std::uint64_t>(pixel_block_);
-    if (!top_up.empty()) {
-        if (b != 1) throw std::invalid_argument("a top-up round with a pixel block");
-        top_up_.assign(width * height, false);
-        for (const std::uint32_t i : top_up) {
-            if (i >= top_up_.size() || top_up_[i]) {
-                throw std::invalid_argument("a top-up pixel outside the image or named twice");
-            }
-            top_up_[i] = true;
-        }
-        rendered_pixels_ = top_up.size();
-        return;
-    }
-    if (b == 1) rendered_pixels_ = width * height;
-    for (std::uint64_t sy = 0; b > 1 && sy * b < height; ++sy) {
-        for (std::uint64_t sx = 0; sx * b < width; ++sx) {
-            const std::uint64_t place = picked_place(sx, sy);
-            rendered_pixels_ += sx * b + place % b < width && sy * b + place / b < height ? 1 : 0;
-        }
-    }
+// The scene's plan with pixel-area sampling on or off.
+RenderPlan plan_with(const Scene& scene, bool antialiasing) {
+    RenderPlan plan = plan_render(scene);
+    plan.effects.antialiasing = antialiasing;
+    return plan;
 }
 
-// Keeps the pilot's choice of pixels apart from other hashes of the seed.
+// Keeps the choice of one pixel per block apart from other hashes of the seed.
 constexpr std::uint64_t kPixelBlockStream = 0x706c6f74ULL;
 
-std::uint64_t RenderContext::picked_place(std::uint64_t sx, std::uint64_t sy) const {
-    if (pixel_block_ == 1) return 0;
-    const auto b = static_cast<std::uint64_t>(pixel_block_);
-    return hash_of(scene_.settings.seed, kPixelBlockStream, sx, sy) % (b * b);
+// With one pixel per block of b, the place (y % b) * b + x % b of the pixel picked in square
+// (sx, sy), counted from the square's corner.
+std::uint64_t picked_place(const RenderRequest& request, std::uint64_t sx, std::uint64_t sy) {
+    const auto b = static_cast<std::uint64_t>(request.pixel_block);
+    return hash_of(request.seed, kPixelBlockStream, sx, sy) % (b * b);
 }
 
-bool RenderContext::renders(int x, int y) const {
-    if (!top_up_.empty()) {
-        return top_up_[static_cast<std::size_t>(y) * std::size_t(scene_.settings.width) +
-                       static_cast<std::size_t>(x)];
+std::size_t pixel_index(const Scene& scene, int x, int y) {
+    return static_cast<std::size_t>(y) * std::size_t(scene.settings.width) +
+           static_cast<std::size_t>(x);
+}
+
+}  // namespace
+
+RenderContext::RenderContext(const Scene& scene)
+    : scene_(scene),
+      sampler_(sampler_named(scene.settings.sampler)),
+      bvh_(scene.objects),
+      area_plan_(plan_with(scene, true)),
+      centre_plan_(plan_with(scene, false)),
+      area_integrator_(make_integrator(scene, area_plan_, bvh_, *sampler_)),
+      centre_integrator_(make_integrator(scene, centre_plan_, bvh_, *sampler_)),
+      tiles_(tile_grid(scene.settings.width, scene.settings.height)) {}
+
+const RenderPlan& RenderContext::plan(const RenderRequest& request) const {
+    return request.samples > 1 ? area_plan_ : centre_plan_;
+}
+
+const PixelIntegrator& RenderContext::integrator(const RenderRequest& request) const {
+    return request.samples > 1 ? *area_integrator_ : *centre_integrator_;
+}
+
+void RenderContext::check(const RenderRequest& request) const {
+    if (request.samples < 1) throw std::invalid_argument("a request of no samples");
+    if (request.pixels == PixelChoice::kOnePerBlock && request.pixel_block < 2) {
+        throw std::invalid_argument("one pixel per block of fewer than 2 x 2");
     }
-    if (pixel_block_ == 1) return true;
-    const auto b = static_cast<std::uint64_t>(pixel_block_);
-    const auto ux = static_cast<std::uint64_t>(x), uy = static_cast<std::uint64_t>(y);
-    return picked_place(ux / b, uy / b) == (uy % b) * b + ux % b;
+    if (request.pixels != PixelChoice::kListed) return;
+    const std::uint64_t count =
+        std::uint64_t(scene_.settings.width) * std::uint64_t(scene_.settings.height);
+    for (std::size_t i = 0; i < request.listed.size(); ++i) {
+        if (request.listed[i] >= count || (i > 0 && request.listed[i] <= request.listed[i - 1])) {
+            throw std::invalid_argument(
+                "a listed pixel outside the image, out of order or named twice");
+        }
+    }
 }
 
-SpreadKind RenderContext::spread_kind() const {
-    // A top-up's spreads are its pairs' own (render_again): the variance of their mean.
-    if (!top_up_.empty()) return SpreadKind::kIndependent;
+std::uint64_t RenderContext::rendered_pixels(const RenderRequest& request) const {
+    const auto width = static_cast<std::uint64_t>(scene_.settings.width);
+    const auto height = static_cast<std::uint64_t>(scene_.settings.height);
+    if (request.pixels == PixelChoice::kAll) return width * height;
+    if (request.pixels == PixelChoice::kListed) return request.listed.size();
+    // One hash a square, as rendered_in takes them.
+    const auto b = static_cast<std::uint64_t>(request.pixel_block);
+    std::uint64_t rendered = 0;
+    for (std::uint64_t sy = 0; sy * b < height; ++sy) {
+        for (std::uint64_t sx = 0; sx * b < width; ++sx) {
+            const std::uint64_t place = picked_place(request, sx, sy);
+            rendered += sx * b + place % b < width && sy * b + place / b < height ? 1 : 0;
+        }
+    }
+    return rendered;
+}
+
+bool RenderContext::renders(const RenderRequest& request, int x, int y) const {
+    switch (request.pixels) {
+        case PixelChoice::kAll:
+            return true;
+        case PixelChoice::kListed:
+            return std::binary_search(request.listed.begin(), request.listed.end(),
+                                      pixel_index(scene_, x, y));
+        case PixelChoice::kOnePerBlock:
+            break;
+    }
+    const auto b = static_cast<std::uint64_t>(request.pixel_block);
+    const auto ux = static_cast<std::uint64_t>(x), uy = static_cast<std::uint64_t>(y);
+    return picked_place(request, ux / b, uy / b) == (uy % b) * b + ux % b;
+}
+
+SpreadKind RenderContext::spread_kind(const RenderRequest& request) const {
+    // A paired request's spreads are its pairs' own (render_again): the variance of their mean.
+    if (request.paired) return SpreadKind::kIndependent;
     return sampler_->independent() ? SpreadKind::kIndependent : SpreadKind::kCalibrated;
 }
 
-std::vector<std::size_t> RenderContext::rendered_in(const Tile& tile) const {
+std::vector<std::size_t> RenderContext::rendered_in(const Tile& tile,
+                                                    const RenderRequest& request) const {
     const auto width = static_cast<std::size_t>(tile.width());
     std::vector<std::size_t> rendered;
-    if (!top_up_.empty()) {
+    if (request.pixels == PixelChoice::kListed) {
         for (int y = tile.y0; y < tile.y1; ++y) {
-            for (int x = tile.x0; x < tile.x1; ++x) {
-                if (renders(x, y)) {
-                    rendered.push_back(static_cast<std::size_t>(y - tile.y0) * width +
-                                       static_cast<std::size_t>(x - tile.x0));
-                }
+            const auto first = std::lower_bound(request.listed.begin(), request.listed.end(),
+                                                pixel_index(scene_, tile.x0, y));
+            const auto last =
+                std::lower_bound(first, request.listed.end(), pixel_index(scene_, tile.x1, y));
+            for (auto p = first; p != last; ++p) {
+                rendered.push_back(static_cast<std::size_t>(y - tile.y0) * width +
+                                   (*p - pixel_index(scene_, tile.x0, y)));
             }
         }
         return rendered;
     }
-    if (pixel_block_ == 1) {
+    if (request.pixels == PixelChoice::kAll) {
         rendered.resize(width * static_cast<std::size_t>(tile.height()));
         std::iota(rendered.begin(), rendered.end(), std::size_t{0});
         return rendered;
     }
-    // One hash a square rather than one a pixel: a pilot's tile holds a few of its pixels among
-    // hundreds, and testing each with renders() took a third of the pilot's time.
-    const int b = pixel_block_;
+    // One hash a square rather than one a pixel: a tile holds a few of the picked pixels among
+    // hundreds.
+    const int b = request.pixel_block;
     for (int sy = tile.y0 / b; sy * b < tile.y1; ++sy) {
         for (int sx = tile.x0 / b; sx * b < tile.x1; ++sx) {
-            const auto place = static_cast<int>(picked_place(std::uint64_t(sx), std::uint64_t(sy)));
+            const auto place =
+                static_cast<int>(picked_place(request, std::uint64_t(sx), std::uint64_t(sy)));
             const int x = sx * b + place % b, y = sy * b + place / b;
             if (x >= tile.x0 && x < tile.x1 && y >= tile.y0 && y < tile.y1) {
                 rendered.push_back(static_cast<std::size_t>(y - tile.y0) * width +
@@ -158,16 +190,16 @@ std::vector<std::size_t> RenderContext::rendered_in(const Tile& tile) const {
     return rendered;
 }
 
-TileBuffer RenderContext::render_tile(const Tile& tile) const {
+TileBuffer RenderContext::render_tile(const Tile& tile, const RenderRequest& request) const {
     TileBuffer buffer{
         tile, Image(tile.width(), tile.height()), {}, Image(tile.width(), tile.height()), {}, {}, 0,
         0};
     const auto width = static_cast<std::size_t>(tile.width());
     Scratch scratch;
     std::vector<Pixel> pixels(width * static_cast<std::size_t>(tile.height()));
-    const std::vector<std::size_t> rendered = rendered_in(tile);
+    const std::vector<std::size_t> rendered = rendered_in(tile, request);
     for (const std::size_t i : rendered) {
-        pixels[i] = render_pixel(tile.x0 + static_cast<int>(i % width),
+        pixels[i] = render_pixel(request, tile.x0 + static_cast<int>(i % width),
                                  tile.y0 + static_cast<int>(i / width), 0, scratch, buffer.rays);
     }
     buffer.pixel_samples.reserve(pixels.size());
@@ -180,55 +212,51 @@ TileBuffer RenderContext::render_tile(const Tile& tile) const {
         buffer.samples += pixel.samples;
         buffer.converged += pixel.converged ? 1 : 0;
     }
-    if (!top_up_.empty()) {
-        render_again(tile, pixels, rendered, scratch, buffer);
-    } else if (estimate_error_ && spread_kind() == SpreadKind::kCalibrated &&
-               scene_.settings.samples >= 2) {
-        calibrate(tile, pixels, rendered, scratch, buffer);
+    if (request.paired) {
+        render_again(request, tile, pixels, rendered, scratch, buffer);
+    } else if (request.estimate_error && spread_kind(request) == SpreadKind::kCalibrated &&
+               request.samples >= 2) {
+        calibrate(request, tile, pixels, rendered, scratch, buffer);
     }
     return buffer;
 }
 
-std::uint64_t RenderContext::estimate_cost(const Tile& tile) const {
-    const int block = scene_.settings.samples >= 16 ? 4 : 8;
+std::uint64_t RenderContext::tile_cost(const Tile& tile, const RenderRequest& request) const {
+    const int block = request.samples >= 16 ? 4 : 8;
     RayCounts rays;
-    std::uint64_t pilots = 0;
+    std::uint64_t probes = 0;
     std::array<Color, 1> color;
     for (int y = tile.y0; y < tile.y1; y += block) {
         for (int x = tile.x0; x < tile.x1; x += block) {
             const int px = std::min(x + block / 2, tile.x1 - 1);
             const int py = std::min(y + block / 2, tile.y1 - 1);
-            const PixelSample s{scene_.settings.seed,
+            const PixelSample s{request.seed,
                                 static_cast<std::uint32_t>(py * scene_.settings.width + px), 0, 1};
-            integrator_->sample_pixel(px, py, s, color, rays);
-            ++pilots;
+            integrator(request).sample_pixel(px, py, s, color, rays);
+            ++probes;
         }
     }
     // Shadow rays left out: a shading point's own work (its light sampling, textures, bump
-    // maps) dwarfs what its shadow rays add (docs/design.md, "costliest first").
+    // maps) dwarfs what its shadow rays add.
     const std::uint64_t shaded = rays.camera + rays.reflection + rays.refraction + rays.diffuse;
     const auto pixels = static_cast<std::uint64_t>(tile.width()) * tile.height();
-    return pilots == 0 ? 0 : shaded * pixels / pilots;
+    return probes == 0 ? 0 : shaded * pixels / probes;
 }
 
 // The key of the second, independent pattern of a pixel rendered twice: a ray-tree path of its
 // own, which every sampler folds into every number it draws.
-constexpr std::uint64_t kCalibrationPath = 0xca11b4a7e5eedULL;
+constexpr std::uint64_t kSecondRenderPath = 0xca11b4a7e5eedULL;
 
-void RenderContext::calibrate(const Tile& tile, std::span<const Pixel> pixels,
-                              std::span<const std::size_t> rendered, Scratch& scratch,
-                              TileBuffer& buffer) const {
-    // A pilot renders every one of its pixels twice: its estimate is then their own mean squared
-    // difference, not a scale taken from some of them times the spreads of all, which at 8
-    // samples follow a pixel's error too loosely (at one pixel in 25 on Test5 at --scale 0.25
-    // the log scatter against the true RMSE fell from 0.166 to 0.116, close to the 0.108 that
-    // the choice of pixels alone leaves; docs/accuracy-history.md). It costs the pilot 40-85 %
-    // more samples, at most a fifth of one sample per image pixel (0.18 at 200 x 150, 0.05 at
-    // 400 x 300 and at 800 x 600).
+void RenderContext::calibrate(const RenderRequest& request, const Tile& tile,
+                              std::span<const Pixel> pixels, std::span<const std::size_t> rendered,
+                              Scratch& scratch, TileBuffer& buffer) const {
+    // One pixel per block: every one twice, so that the estimate is their own mean squared
+    // difference; a scale taken from some of them times the spreads of all follows a pixel's
+    // error too loosely at few samples.
     const std::vector<double> odds =
-        pixel_block_ == 1
-            ? calibration_odds(buffer.spread, calibration_share(double(rendered_pixels_)))
-            : std::vector<double>(pixels.size(), 1.0);
+        request.pixels == PixelChoice::kOnePerBlock
+            ? std::vector<double>(pixels.size(), 1.0)
+            : calibration_odds(buffer.spread, calibration_share(double(rendered_pixels(request))));
     // The second renders' rays stay out of the image's ray counts: they are the estimate's cost,
     // which the sums count in camera samples.
     RayCounts rays;
@@ -237,21 +265,22 @@ void RenderContext::calibrate(const Tile& tile, std::span<const Pixel> pixels,
         const int x = tile.x0 + static_cast<int>(i % width);
         const int y = tile.y0 + static_cast<int>(i / width);
         const auto pixel = static_cast<std::uint32_t>(y * scene_.settings.width + x);
-        if (to_unit(hash_of(scene_.settings.seed, pixel, kCalibrationPath)) >= odds[i]) continue;
-        const Pixel again = render_pixel(x, y, kCalibrationPath, scratch, rays);
+        if (to_unit(hash_of(request.seed, pixel, kSecondRenderPath)) >= odds[i]) continue;
+        const Pixel again = render_pixel(request, x, y, kSecondRenderPath, scratch, rays);
         add_calibration(buffer.error_sums, pixels[i].value, again.value, pixels[i].spread, odds[i],
                         again.samples);
     }
 }
 
-void RenderContext::render_again(const Tile& tile, std::span<const Pixel> pixels,
+void RenderContext::render_again(const RenderRequest& request, const Tile& tile,
+                                 std::span<const Pixel> pixels,
                                  std::span<const std::size_t> rendered, Scratch& scratch,
                                  TileBuffer& buffer) const {
     const auto width = static_cast<std::size_t>(tile.width());
     for (const std::size_t i : rendered) {
         const int x = static_cast<int>(i % width), y = static_cast<int>(i / width);
-        const Pixel again =
-            render_pixel(tile.x0 + x, tile.y0 + y, kCalibrationPath, scratch, buffer.rays);
+        const Pixel again = render_pixel(request, tile.x0 + x, tile.y0 + y, kSecondRenderPath,
+                                         scratch, buffer.rays);
         const Color first = pixels[i].value;
         const Color difference = first - again.value;
         buffer.pixels.set(x, y, (first + again.value) * 0.5);
@@ -262,22 +291,24 @@ void RenderContext::render_again(const Tile& tile, std::span<const Pixel> pixels
     }
 }
 
-RenderContext::Pixel RenderContext::render_pixel(int x, int y, std::uint64_t path, Scratch& scratch,
+RenderContext::Pixel RenderContext::render_pixel(const RenderRequest& request, int x, int y,
+                                                 std::uint64_t path, Scratch& scratch,
                                                  RayCounts& rays) const {
-    return adaptive_ ? adaptive_pixel(x, y, path, scratch, rays)
-                     : plain_pixel(x, y, path, scratch, rays);
+    return request.adaptive ? adaptive_pixel(request, x, y, path, scratch, rays)
+                            : plain_pixel(request, x, y, path, scratch, rays);
 }
 
-RenderContext::Pixel RenderContext::plain_pixel(int x, int y, std::uint64_t path, Scratch& scratch,
+RenderContext::Pixel RenderContext::plain_pixel(const RenderRequest& request, int x, int y,
+                                                std::uint64_t path, Scratch& scratch,
                                                 RayCounts& rays) const {
-    const auto spp = static_cast<std::uint32_t>(scene_.settings.samples);
-    const PixelSample s{scene_.settings.seed,
-                        static_cast<std::uint32_t>(y * scene_.settings.width + x), 0, spp, path};
+    const auto spp = static_cast<std::uint32_t>(request.samples);
+    const PixelSample s{request.seed, static_cast<std::uint32_t>(y * scene_.settings.width + x), 0,
+                        spp, path};
     scratch.colors.resize(spp);
-    integrator_->sample_pixel(x, y, s, scratch.colors, rays);
+    integrator(request).sample_pixel(x, y, s, scratch.colors, rays);
     Color sum;
     for (const Color& c : scratch.colors) sum += c;
-    if (sampler_->independent() || !plan_.effects.antialiasing || !estimate_error_) {
+    if (sampler_->independent() || !plan(request).effects.antialiasing || !request.estimate_error) {
         return {sum / spp, pixel_spread(scratch.colors), spp, false};
     }
     // The samples' places in the pixel, as the integrator drew them: the strata they fell in.
@@ -289,16 +320,18 @@ RenderContext::Pixel RenderContext::plain_pixel(int x, int y, std::uint64_t path
 }
 
 // Rounds of as many samples as taken so far, until the standard error of the mean luminance is
-// below the threshold. A progressive sampler continues one pattern; any other starts a new
+// below the threshold. An extensible sampler continues one pattern; any other starts a new
 // pattern of the round's size, on its own ray-tree path, in each round (the first round is
-// exactly a plain render at the minimum count). A second render for the calibration (`path`
-// not 0) does all that on paths of its own.
-RenderContext::Pixel RenderContext::adaptive_pixel(int x, int y, std::uint64_t path,
-                                                   Scratch& scratch, RayCounts& rays) const {
-    const auto spp = static_cast<std::uint32_t>(scene_.settings.samples);
-    const auto min_spp = static_cast<std::uint32_t>(adaptive_->min_samples);
+// exactly a plain render at the minimum count). A second render (`path` not 0) does all that on
+// paths of its own.
+RenderContext::Pixel RenderContext::adaptive_pixel(const RenderRequest& request, int x, int y,
+                                                   std::uint64_t path, Scratch& scratch,
+                                                   RayCounts& rays) const {
+    const auto spp = static_cast<std::uint32_t>(request.samples);
+    const AdaptiveSampling adaptive = *request.applied_adaptive();
+    const auto min_spp = static_cast<std::uint32_t>(adaptive.min_samples);
     const auto pixel = static_cast<std::uint32_t>(y * scene_.settings.width + x);
-    const bool progressive = sampler_->progressive();
+    const bool extensible = sampler_->extensible();
     std::vector<double>& luminances = scratch.luminances;
     Color sum;
     bool converged = false;
@@ -307,20 +340,20 @@ RenderContext::Pixel RenderContext::adaptive_pixel(int x, int y, std::uint64_t p
     for (std::uint32_t round = 0;; ++round) {
         const auto n = static_cast<std::uint32_t>(luminances.size());
         const std::uint32_t batch = std::min(round == 0 ? min_spp : n, spp - n);
-        PixelSample s{scene_.settings.seed, pixel, 0, progressive ? spp : batch, path};
-        if (!progressive && round > 0) {
+        PixelSample s{request.seed, pixel, 0, extensible ? spp : batch, path};
+        if (!extensible && round > 0) {
             s.path = path == 0 ? hash_of(0xada9717eULL, round) : hash_of(path, round);
         }
-        s.index = progressive ? n : 0;
+        s.index = extensible ? n : 0;
         scratch.colors.resize(batch);
-        integrator_->sample_pixel(x, y, s, scratch.colors, rays);
+        integrator(request).sample_pixel(x, y, s, scratch.colors, rays);
         for (const Color& c : scratch.colors) {
             sum += c;
             luminances.push_back(luminance(c));
             scratch.taken.push_back(c);
         }
         if (luminances.size() >= spp) break;
-        if (standard_error(luminances, progressive) < adaptive_->noise_threshold) {
+        if (standard_error(luminances, extensible) < adaptive.noise_threshold) {
             converged = true;
             break;
         }
@@ -329,17 +362,17 @@ RenderContext::Pixel RenderContext::adaptive_pixel(int x, int y, std::uint64_t p
     return {sum / n, pixel_spread(scratch.taken), n, converged};
 }
 
-std::vector<Tile> costly_first(const RenderContext& context, std::vector<Tile> tiles, int workers,
-                               int threads) {
+std::vector<Tile> costly_first(const RenderContext& context, const RenderRequest& request,
+                               std::vector<Tile> tiles, int workers, int threads) {
     if (workers <= 1 || tiles.size() <= 1) return tiles;
     std::vector<std::pair<std::uint64_t, Tile> > costed(tiles.size());
-    // The pilot runs before any worker starts: spread over the threads, it keeps them waiting
-    // for a share of it only.
+    // The probes run before any worker starts: spread over the threads, they keep them waiting
+    // for a share of them only.
     std::atomic<std::size_t> next{0};
     const auto most = static_cast<int>(std::min<std::size_t>(tiles.size(), INT_MAX));
     run_on_threads(std::min(threads, most), [&](const std::atomic<bool>& failed) {
         for (std::size_t i = next++; i < tiles.size() && !failed.load(); i = next++) {
-            costed[i] = {context.estimate_cost(tiles[i]), tiles[i]};
+            costed[i] = {context.tile_cost(tiles[i], request), tiles[i]};
         }
     });
     std::stable_sort(costed.begin(), costed.end(),

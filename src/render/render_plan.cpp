@@ -106,12 +106,12 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
         << "max depth: " << s.max_depth << "\n"
         << "glossy rays: " << s.glossy_rays << "\n"
         << "seed: " << s.seed << "\n"
-        << "sampler: " << s.sampler << "\n"
-        << "integrator: "
-        << (s.integrator == IntegratorKind::kPath ? "path (unbiased path tracing)"
-                                                  : "distributed (the thesis's)")
-        << "\n"
-        << "camera: " << (scene.view ? "look-at" : "thesis pixel plane")
+        << "sampler: " << s.sampler << "\n";
+    // A distributed scene without emitting surfaces is described as before the path integrator
+    // and emitters existed.
+    const bool path = s.integrator == IntegratorKind::kPath;
+    if (path) out << "integrator: path (unbiased path tracing)\n";
+    out << "camera: " << (scene.view ? "look-at" : "thesis pixel plane")
         << (scene.lens.is_pinhole() ? ", pinhole" : ", thin lens") << "\n"
         << "materials: " << scene.materials.size() << "\n"
         << "objects: " << scene.objects.size() << " (" << moving << " moving)\n"
@@ -121,7 +121,14 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
             << ", power " << scene.lights[i]->power() << ", shadow rays per shading point "
             << plan.shadow_rays[i] << "\n";
     }
-    out << "emitters: " << plan.emitters.size() << "\n";
+    std::size_t emitting_planes = 0;
+    for (const auto& object : scene.objects) {
+        const Shapes shapes = object->shapes();
+        emitting_planes += object->material().emits() ? shapes.planes.size() : 0;
+    }
+    if (path || plan.emitters.size() > 0 || emitting_planes > 0) {
+        out << "emitters: " << plan.emitters.size() << "\n";
+    }
     for (std::size_t i = 0; i < plan.emitters.size(); ++i) {
         const Emitters::Emitter& e = plan.emitters[i];
         out << "  emitter " << i << ": ";
@@ -138,11 +145,6 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
         }
         out << ", power " << e.power << ", shadow rays per shading point " << plan.emitter_rays[i]
             << "\n";
-    }
-    std::size_t emitting_planes = 0;
-    for (const auto& object : scene.objects) {
-        const Shapes shapes = object->shapes();
-        emitting_planes += object->material().emits() ? shapes.planes.size() : 0;
     }
     if (emitting_planes > 0) {
         out << "  emitting planes: " << emitting_planes
@@ -162,8 +164,8 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
         << "  depth_of_field: " << flag(e.depth_of_field) << "\n"
         << "  motion_blur: " << flag(e.motion_blur);
     if (e.motion_blur) out << " (shutter 0.." << plan.shutter_end << ")";
-    out << "\n"
-        << "  indirect_light: " << flag(e.indirect_light) << "\n";
+    out << "\n";
+    if (path) out << "  indirect_light: " << flag(e.indirect_light) << "\n";
     return out.str();
 }
 

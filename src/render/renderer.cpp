@@ -20,8 +20,9 @@ double seconds_since(Clock::time_point start) {
 
 }  // namespace
 
-int render_tiles(const RenderContext& context, TileSource& source, TileSink& sink,
-                 const RenderOptions& options) {
+int render_tiles(const RenderContext& context, const RenderRequest& request, TileSource& source,
+                 TileSink& sink, const RenderOptions& options) {
+    context.check(request);
     const int threads =
         std::max(1, std::min(worker_threads(options.threads), static_cast<int>(source.size())));
     std::atomic<std::size_t> tiles_done{0};
@@ -33,7 +34,7 @@ int render_tiles(const RenderContext& context, TileSource& source, TileSink& sin
             while (!failed.load(std::memory_order_relaxed) && !options.stop.stop_requested()) {
                 const std::optional<Tile> tile = source.next();
                 if (!tile) break;
-                sink.add(context.render_tile(*tile));
+                sink.add(context.render_tile(*tile, request));
                 tiles_done.fetch_add(1, std::memory_order_relaxed);
             }
         },
@@ -42,7 +43,8 @@ int render_tiles(const RenderContext& context, TileSource& source, TileSink& sin
     return threads;
 }
 
-RenderResult render(const RenderContext& context, ImageSink& sink, const RenderOptions& options) {
+RenderResult complete_render(const RenderContext& context, const RenderRequest& request,
+                             ImageSink& sink, const RenderOptions& options) {
     const auto start = Clock::now();
     TileQueue source(sink.missing());
     RenderOptions run = options;
@@ -55,28 +57,29 @@ RenderResult render(const RenderContext& context, ImageSink& sink, const RenderO
             options.on_progress(before + share * done);
         };
     }
-    const int threads = render_tiles(context, source, sink, run);
-    RenderResult result = assembled(context, sink);
+    const int threads = render_tiles(context, request, source, sink, run);
+    RenderResult result = assembled(context, request, sink);
     result.stats.threads = threads;
     result.stats.seconds = seconds_since(start);
     return result;
 }
 
-RenderResult assembled(const RenderContext& context, const ImageSink& sink) {
+RenderResult assembled(const RenderContext& context, const RenderRequest& request,
+                       const ImageSink& sink) {
     RenderResult result;
     result.image = sink.image();
-    result.plan = context.plan();
-    result.stats.adaptive = context.adaptive();
-    if (context.adaptive()) result.pixel_samples = sink.pixel_samples();
+    result.plan = context.plan(request);
+    result.stats.adaptive = request.applied_adaptive();
+    if (request.adaptive) result.pixel_samples = sink.pixel_samples();
     result.stats.rays = sink.rays();
     result.stats.samples = sink.samples();
     result.stats.pixels_converged = sink.converged();
     result.unfinished = sink.missing();
     result.spread = sink.spread();
     if (result.unfinished.empty()) {
-        result.stats.error = estimate_error(result.image, result.spread, sink.error_sums(),
-                                            sink.samples(), context.scene().settings.samples,
-                                            context.spread_kind(), context.rendered_pixels());
+        result.stats.error = estimate_error(
+            result.image, result.spread, sink.error_sums(), sink.samples(), request.samples,
+            context.spread_kind(request), context.rendered_pixels(request));
     } else {
         result.stats.error.unavailable = "the render is unfinished";
     }
@@ -84,10 +87,17 @@ RenderResult assembled(const RenderContext& context, const ImageSink& sink) {
 }
 
 RenderResult render(const Scene& scene, const RenderOptions& options) {
+    RenderRequest request = RenderRequest::whole_image(scene.settings);
+    request.adaptive = options.adaptive;
+    return render(scene, request, options);
+}
+
+RenderResult render(const Scene& scene, const RenderRequest& request,
+                    const RenderOptions& options) {
     const auto start = Clock::now();
-    const RenderContext context(scene, options.adaptive);
+    const RenderContext context(scene);
     ImageSink sink(scene.settings.width, scene.settings.height, context.tiles());
-    RenderResult result = render(context, sink, options);
+    RenderResult result = complete_render(context, request, sink, options);
     result.stats.seconds = seconds_since(start);
     return result;
 }

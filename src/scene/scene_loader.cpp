@@ -11,17 +11,14 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <functional>
 #include <map>
 #include <optional>
 #include <span>
 #include <string>
-#include <system_error>
 #include <type_traits>
 #include <vector>
 
@@ -31,6 +28,7 @@
 #include "drt/io/obj_reader.h"
 #include "drt/sampling/sampler.h"
 #include "drt/shading/texture.h"
+#include "drt/util/file_reader.h"
 #include "drt/util/limits.h"
 #include "drt/util/text.h"
 
@@ -747,6 +745,9 @@ class SceneReader {
         warn_children(e);
         auto mesh = build_mesh(in, std::move(obj), {}, false);
         if (mesh->dropped() > 0) context_.warn(e, "<Triangle> of zero area dropped");
+        if (mesh->collapsed() > 0) {
+            context_.warn(e, "<Triangle> too thin for single precision dropped");
+        }
         pending_.push_back({&e, std::move(material), std::move(surface),
                             [mesh = std::move(mesh)](const Material& m, SurfaceDetail d) {
                                 return std::make_unique<Mesh>(mesh, std::vector<Vec3>{Vec3{}}, m,
@@ -785,6 +786,10 @@ class SceneReader {
         if (const std::size_t n = mesh->dropped(); n > 0) {
             context_.warn(e, std::to_string(n) + (n == 1 ? " triangle" : " triangles") +
                                  " of zero area in " + obj_path.string() + " dropped");
+        }
+        if (const std::size_t n = mesh->collapsed(); n > 0) {
+            context_.warn(e, std::to_string(n) + (n == 1 ? " triangle" : " triangles") + " in " +
+                                 obj_path.string() + " too thin for single precision dropped");
         }
         pending_.push_back(
             {&e, std::move(material), std::move(surface),
@@ -844,34 +849,22 @@ class SceneReader {
     std::vector<std::filesystem::path> files_read_;
 };
 
-std::string read_file(const std::filesystem::path& path) {
-    const auto cannot_open = [&](int error) {
-        return SceneError(printable(path.string()) + ": cannot open scene: " +
-                          std::error_code(error, std::generic_category()).message());
-    };
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
-                                                         &std::fclose);
-    if (!file) throw cannot_open(errno);
-    std::string contents;
-    char buffer[1 << 16];
-    std::size_t n = 0;
-    while ((n = std::fread(buffer, 1, sizeof buffer, file.get())) > 0) {
-        // Checked while reading, so that an endless input (/dev/zero) stops too.
-        if (contents.size() + n > kMaxSceneBytes) {
+std::string read_scene_file(const std::filesystem::path& path) {
+    try {
+        return read_text_file(path, kMaxSceneBytes);
+    } catch (const FileReadError& e) {
+        if (e.problem() == FileProblem::too_large) {
             throw SceneError(printable(path.string()) + ": scene file larger than the " +
                              std::to_string(kMaxSceneBytes >> 20) + " MiB limit");
         }
-        contents.append(buffer, n);
+        throw SceneError(printable(path.string()) + ": cannot open scene: " + e.reason());
     }
-    // A directory opens fine on Linux and fails only when read (EISDIR).
-    if (std::ferror(file.get())) throw cannot_open(errno);
-    return contents;
 }
 
 }  // namespace
 
 LoadedScene load_scene(const std::filesystem::path& path) {
-    const std::string xml = read_file(path);
+    const std::string xml = read_scene_file(path);
     return SceneReader(path.string()).read(xml);
 }
 

@@ -6,14 +6,13 @@
 #include <cstring>
 #include <vector>
 
-#include "drt/accel/mesh.h"
+#include "drt/accel/triangle_mesh.h"
 #include "drt/util/rng.h"
 #include "test_meshes.h"
 
 namespace drt {
 namespace {
 
-using Float3 = std::array<float, 3>;
 using Triangle = std::array<std::uint32_t, 3>;
 
 struct Soup {

@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -525,6 +526,30 @@ TEST_F(CliTest, StatsShowOnlyWhatASceneCallsFor) {
     EXPECT_FALSE(parse_json(r.out)["effects"]["antialiasing"].boolean());
 }
 
+// The path integrator's keys are in its renders' statistics only: a distributed render's keys
+// are those it had before that integrator existed.
+TEST_F(CliTest, DiffuseRaysAndIndirectLightOnlyInAPathRendersStats) {
+    const Outcome distributed =
+        run({"scene.xml", "-q", "--spp", "2", "--stats", "-", "-o", "a.pfm"});
+    ASSERT_EQ(distributed.status, 0) << distributed.err;
+    const Json d = parse_json(distributed.out);
+    EXPECT_FALSE(d["rays"].has("diffuse"));
+    EXPECT_FALSE(d["effects"].has("indirect_light"));
+
+    std::string path_scene = kScene;
+    path_scene.replace(path_scene.find("<Render "), 8, "<Render Integrator=\"path\" ");
+    write_bytes(file("path.xml"), path_scene);
+    const Outcome path = run({"path.xml", "-q", "--spp", "2", "--stats", "-", "-o", "b.pfm"});
+    ASSERT_EQ(path.status, 0) << path.err;
+    const Json p = parse_json(path.out);
+    const Json& rays = p["rays"];
+    EXPECT_GT(rays["diffuse"].number(), 0);
+    EXPECT_EQ(rays["total"].number(), rays["camera"].number() + rays["shadow"].number() +
+                                          rays["reflection"].number() +
+                                          rays["refraction"].number() + rays["diffuse"].number());
+    EXPECT_TRUE(p["effects"]["indirect_light"].boolean());
+}
+
 // ---- batch
 // ----------------------------------------------------------------------------------------
 
@@ -929,19 +954,53 @@ TEST_F(CliTest, UnwritableStatsIsRefusedBeforeTheImageReplacesTheOutput) {
 TEST_F(CliTest, NonFinitePixelsAreCountedAndFailTheRun) {
     // Finite in the scene, beyond a float in the image: 1e39 and a background of 1.7e308.
     write_bytes(file("bright.xml"), scene_with("Ir=\"1\"", "Ir=\"1e39\""));
-    const Outcome r = run({"bright.xml", "-o", "bright.pfm", "-q"});
+    const Outcome r = run({"bright.xml", "-o", "bright.png", "-q"});
     EXPECT_EQ(r.status, 2);
     EXPECT_TRUE(regex_search(r.err,
                              "^drt: bright\\.xml: [0-9]+ of 1152 channel values are not "
                              "finite \\(radiance beyond the float range: a light, "
-                             "background or ambient too bright\\?\\)\n$"))
+                             "background or ambient too bright\\?\\)\n"
+                             "drt: bright\\.xml: .*bright\\.png not written; the image is kept "
+                             "for inspection in .*bright\\.nonfinite\\.pfm\n$"))
         << r.err;
-    EXPECT_TRUE(fs::exists(file("bright.pfm")));  // kept for inspection
     write_bytes(file("sky.xml"), scene_with("<Background r=\"0.1\"", "<Background r=\"1.7e308\""));
     const Outcome sky = run({"sky.xml", "-o", "sky.pfm", "-q"});
     EXPECT_EQ(sky.status, 2);
     EXPECT_NE(sky.err.find("channel values are not finite"), std::string::npos) << sky.err;
     EXPECT_EQ(run({"scene.xml", "-o", "ok.pfm", "-q"}).status, 0);
+}
+
+TEST_F(CliTest, NonFinitePixelsLeaveTheOutputAsItWasAndKeepTheImageBesideIt) {
+    write_bytes(file("bright.xml"), scene_with("Ir=\"1\"", "Ir=\"1e39\""));
+    write_bytes(file("out.png"), "an earlier render");
+    const Outcome r = run({"bright.xml", "-o", "out.png"});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(read_bytes(file("out.png")), "an earlier render");
+    // The inspection image holds the very values the message counts.
+    const Image kept = read_image(file("out.nonfinite.pfm"));
+    EXPECT_EQ(kept.width * kept.height * 3, 1152);
+    const auto bad =
+        std::count_if(kept.rgb.begin(), kept.rgb.end(), [](float v) { return !std::isfinite(v); });
+    EXPECT_GT(bad, 0);
+    EXPECT_NE(r.err.find("drt: wrote out.nonfinite.pfm ("), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("drt: bright.xml: " + std::to_string(bad) +
+                         " of 1152 channel values are not finite"),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("drt: bright.xml: out.png not written; the image is kept for "
+                         "inspection in out.nonfinite.pfm\n"),
+              std::string::npos)
+        << r.err;
+    // No earlier output: none is made; in a batch, the image is kept beside the scene's output.
+    const Outcome fresh = run({"bright.xml", "-o", "fresh.pfm", "-q"});
+    EXPECT_EQ(fresh.status, 2);
+    const Outcome batch = run({"bright.xml", "scene.xml", "-o", "batch/", "-q"});
+    EXPECT_EQ(batch.status, 2);
+    EXPECT_EQ(entries(dir_),
+              (std::vector<std::string>{"batch", "bright.xml", "fresh.nonfinite.pfm",
+                                        "out.nonfinite.pfm", "out.png", "scene.xml"}));
+    EXPECT_EQ(entries(file("batch")),
+              (std::vector<std::string>{"bright.nonfinite.pfm", "scene.png"}));
 }
 
 TEST_F(CliTest, ControlCharactersAreEscapedInEveryMessage) {

@@ -34,7 +34,7 @@ Scene edge_scene(const std::string& sampler) {
 
 Image reference_for(const std::string& sampler) {
     Scene scene = edge_scene(sampler);
-    return render_with(scene, 2048, 99, {}).image;
+    return render(scene, request_at(2048, 99, {}), {}).image;
 }
 
 TEST(Converge, RmseAndRelativeMseOfKnownImages) {
@@ -107,7 +107,7 @@ TEST(Converge, MeasuresEachCountAndRestoresTheScene) {
     EXPECT_EQ(scene.settings.samples, 3);
     EXPECT_EQ(scene.settings.seed, 5u);
     // Each point is the error of a plain render with the scene's seed at that count.
-    const Image at4 = render_with(scene, 4, 5, {}).image;
+    const Image at4 = render(scene, request_at(4, 5, {}), {}).image;
     EXPECT_EQ(c.points[1].rmse, rmse(at4, reference));
     EXPECT_EQ(c.points[1].relmse, relative_mse(at4, reference));
     EXPECT_EQ(c.points[1].mean_spp, 4);

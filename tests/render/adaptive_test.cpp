@@ -94,7 +94,7 @@ TEST(Adaptive, SamplesComeInDoublingRoundsAndGrowAsTheThresholdFalls) {
 }
 
 // A pixel that stops at the minimum holds exactly what a plain render at the minimum gives it,
-// and with the progressive Sobol sampler a pixel that runs to the maximum holds exactly what a
+// and with the extensible Sobol sampler a pixel that runs to the maximum holds exactly what a
 // plain render at the maximum gives it.
 TEST(Adaptive, PixelsMatchPlainRendersAtTheCountTheyStoppedAt) {
     for (const std::string sampler : {"stratified", "sobol"}) {
@@ -124,10 +124,10 @@ TEST(Adaptive, PixelsMatchPlainRendersAtTheCountTheyStoppedAt) {
     }
 }
 
-// Independent samples are judged by their sample deviation; a progressive sampler's by the
+// Independent samples are judged by their sample deviation; an extensible sampler's by the
 // spread of the means of 8 consecutive runs, each run a stratified pattern, which credits
 // stratification: at the same threshold edges stop far earlier, yet the image is more accurate.
-TEST(Adaptive, StratificationIsCreditedForAProgressiveSampler) {
+TEST(Adaptive, StratificationIsCreditedForAnExtensibleSampler) {
     Scene scene = edge_scene("sobol", 4096);
     scene.settings.seed = 11;
     const Image reference = render(scene, {}).image;

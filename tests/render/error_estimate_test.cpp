@@ -117,6 +117,27 @@ TEST(StrataSpread, GuessesAStratifiedPixelsVarianceWhereTheSampleVarianceCannot)
     EXPECT_GT(edge.sample / edge.truth, 20);
 }
 
+TEST(LargestAround, TheLargestOfTheEightNeighboursWithOrWithoutThePixelItself) {
+    // 3 x 3 with a peak of 5 in the middle and 2 in a corner.
+    const std::vector<double> values{2, 0, 0, 0, 5, 0, 0, 0, 1};
+    const std::vector<double> with = largest_around(values, 3, 3, Around::kWithSelf);
+    EXPECT_EQ(with, (std::vector<double>{5, 5, 5, 5, 5, 5, 5, 5, 5}));
+    const std::vector<double> without = largest_around(values, 3, 3, Around::kNeighboursOnly);
+    // The middle sees the corners, not itself; the corners see the middle.
+    EXPECT_EQ(without, (std::vector<double>{5, 5, 5, 5, 2, 5, 5, 5, 5}));
+    // A row: the ends have one neighbour.
+    EXPECT_EQ(largest_around(std::vector<double>{1, 4, 2}, 3, 1, Around::kNeighboursOnly),
+              (std::vector<double>{4, 2, 4}));
+}
+
+TEST(PickOdds, AQuarterEvenlyAndThreeQuartersByWeightAtMostOne) {
+    EXPECT_DOUBLE_EQ(pick_odds(0.1, 1, 3, 2.6), 0.1 * (0.25 + 0.75 * 3 / 2.6));
+    // 10 picks over 400 pixels, a pixel with a tenth of the weight, and one with half of it.
+    EXPECT_DOUBLE_EQ(pick_odds(10, 1.0 / 400, 0.1, 1), 10 * (0.25 / 400 + 0.075));
+    EXPECT_EQ(pick_odds(10, 1.0 / 400, 0.5, 1), 1.0);
+    EXPECT_EQ(pick_odds(0.5, 1, 0, 1), 0.125);
+}
+
 TEST(CalibrationOdds, AQuarterSharedAndTheRestByTheLargestSpreadAround) {
     Image spread(5, 1);
     // Sums 0, 3, 1, 0, 2; the largest of each pixel and its neighbours 3, 3, 3, 2, 2 (mean 2.6).
@@ -311,15 +332,16 @@ TEST(EstimateError, SameForAnyThreadsAndTileOrder) {
         one.threads = 1;
         const RenderResult a = render(scene, one);
         // Two threads, the tiles backwards.
-        const RenderContext context(scene, std::nullopt);
+        const RenderContext context(scene);
+        const RenderRequest request = RenderRequest::whole_image(scene.settings);
         ImageSink sink(scene.settings.width, scene.settings.height, context.tiles());
         std::vector<Tile> backwards = context.tiles();
         std::reverse(backwards.begin(), backwards.end());
         TileQueue source(backwards);
         RenderOptions two;
         two.threads = 2;
-        render_tiles(context, source, sink, two);
-        const RenderResult b = assembled(context, sink);
+        render_tiles(context, request, source, sink, two);
+        const RenderResult b = assembled(context, request, sink);
         EXPECT_EQ(a.image.rgb, b.image.rgb);
         EXPECT_EQ(a.spread.rgb, b.spread.rgb) << sampler;
         ASSERT_TRUE(a.stats.error.available() && b.stats.error.available()) << sampler;

@@ -368,7 +368,8 @@ TEST(MeshRender, SliverAndDegenerateTrianglesNeverGiveANonFinitePixel) {
     const auto mesh = std::make_shared<const TriangleMesh>(obj, MeshTransform{1.5, {}}, true);
     // The two of zero area, and 15 needles thinner than single precision resolves about the
     // mesh's centre, which collapse onto lines.
-    EXPECT_EQ(mesh->dropped(), 17u);
+    EXPECT_EQ(mesh->dropped(), 2u);
+    EXPECT_EQ(mesh->collapsed(), 15u);
     EXPECT_EQ(mesh->triangle_count(), 68u);
     // What shading takes from each triangle: finite everywhere on it. (The integrator's
     // comparisons would turn a NaN normal into a black pixel, not a NaN one: the image alone

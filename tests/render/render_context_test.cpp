@@ -1,11 +1,12 @@
-// The cost guess that orders the tiles: shaded rays a pilot traces, scaled to the tile, and the
-// order it gives (which changes no pixel: renderer_test.cpp renders tiles in any order); a
-// render without its error estimate.
+// The cost guess that orders the tiles: shaded rays the probes trace, scaled to the tile, and the
+// order it gives (which changes no pixel: renderer_test.cpp renders tiles in any order); requests
+// against one context: without the error estimate, one pixel per block, listed pixels paired.
 #include "drt/render/render_context.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <utility>
 #include <vector>
 
 #include "drt/scene/light.h"
@@ -21,24 +22,25 @@ Scene mirror_ball() {
     return testing::lone_sphere_scene(testing::mirror({0.5, 0.5, 0.5}), {0.1, 0.2, 0.3}, 96);
 }
 
-TEST(EstimateCost, CountsThePilotsShadedRaysScaledToTheTile) {
+TEST(TileCost, CountsTheProbesShadedRaysScaledToTheTile) {
     const Scene scene = mirror_ball();
-    const RenderContext context(scene, std::nullopt);
+    const RenderContext context(scene);
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
     const std::vector<Tile>& tiles = context.tiles();
     ASSERT_EQ(tiles.size(), 36u);
-    EXPECT_EQ(context.estimate_cost(tiles[0]), 256u);  // top left: background only
-    EXPECT_EQ(context.estimate_cost(tiles[35]), 256u);
-    EXPECT_EQ(context.estimate_cost(tiles[14]), 512u);  // beside the centre: all mirror
-    EXPECT_EQ(context.estimate_cost(tiles[21]), 512u);
+    EXPECT_EQ(context.tile_cost(tiles[0], request), 256u);  // top left: background only
+    EXPECT_EQ(context.tile_cost(tiles[35], request), 256u);
+    EXPECT_EQ(context.tile_cost(tiles[14], request), 512u);  // beside the centre: all mirror
+    EXPECT_EQ(context.tile_cost(tiles[21], request), 512u);
     // An edge tile of 8 × 16 pixels, background only: half the cost.
     const Scene narrow =
         testing::lone_sphere_scene(testing::mirror({0.5, 0.5, 0.5}), {0.1, 0.2, 0.3}, 88);
-    const RenderContext cut(narrow, std::nullopt);
+    const RenderContext cut(narrow);
     EXPECT_EQ(cut.tiles()[5].width(), 8);
-    EXPECT_EQ(cut.estimate_cost(cut.tiles()[5]), 128u);
+    EXPECT_EQ(cut.tile_cost(cut.tiles()[5], request), 128u);
 }
 
-TEST(EstimateCost, LeavesShadowRaysOut) {
+TEST(TileCost, LeavesShadowRaysOut) {
     // A grey ball lit through 8 shadow rays a shading point: the tiles on the ball trace 9 rays a
     // camera sample, those of the background 1, yet both count one shaded ray a pixel — a shading
     // point's own work, not its shadow rays, is what a tile's time follows (design.md).
@@ -46,24 +48,26 @@ TEST(EstimateCost, LeavesShadowRaysOut) {
     scene.settings.shadow_rays = 8;
     scene.lights.push_back(
         std::make_unique<SphereLight>(Vec3{0, 5, -10}, 1.0, Color{1, 1, 1}, false));
-    const RenderContext context(scene, std::nullopt);
-    const TileBuffer ball = context.render_tile(context.tiles()[14]);
+    const RenderContext context(scene);
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
+    const TileBuffer ball = context.render_tile(context.tiles()[14], request);
     ASSERT_EQ(ball.rays.shadow, 8u * ball.rays.camera);  // every pixel on the lit side
-    EXPECT_EQ(context.estimate_cost(context.tiles()[14]), 256u);
-    EXPECT_EQ(context.estimate_cost(context.tiles()[0]), 256u);
+    EXPECT_EQ(context.tile_cost(context.tiles()[14], request), 256u);
+    EXPECT_EQ(context.tile_cost(context.tiles()[0], request), 256u);
 }
 
 TEST(CostlyFirst, OrdersByFallingCostAndKeepsIndexOrderAmongEquals) {
     const Scene scene = mirror_ball();
-    const RenderContext context(scene, std::nullopt);
-    const std::vector<Tile> order = costly_first(context, context.tiles(), 2);
+    const RenderContext context(scene);
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
+    const std::vector<Tile> order = costly_first(context, request, context.tiles(), 2);
     ASSERT_EQ(order.size(), context.tiles().size());
     EXPECT_TRUE(std::is_permutation(order.begin(), order.end(), context.tiles().begin()));
     EXPECT_EQ(order.front().index, 7u);  // the first of the all-mirror tiles
     EXPECT_EQ(order.back().index, 35u);  // the last of the background-only ones
     for (std::size_t i = 1; i < order.size(); ++i) {
-        const auto before = context.estimate_cost(order[i - 1]);
-        const auto after = context.estimate_cost(order[i]);
+        const auto before = context.tile_cost(order[i - 1], request);
+        const auto after = context.tile_cost(order[i], request);
         EXPECT_GE(before, after) << i;
         if (before == after) {
             EXPECT_LT(order[i - 1].index, order[i].index) << i;
@@ -73,28 +77,33 @@ TEST(CostlyFirst, OrdersByFallingCostAndKeepsIndexOrderAmongEquals) {
 
 TEST(CostlyFirst, ThePilotsThreadsChangeNoPlace) {
     const Scene scene = testing::scaled_scene("thesis/test4.xml", 80, 4);
-    const RenderContext context(scene, std::nullopt);
-    const std::vector<Tile> one = costly_first(context, context.tiles(), 2, 1);
+    const RenderContext context(scene);
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
+    const std::vector<Tile> one = costly_first(context, request, context.tiles(), 2, 1);
     ASSERT_NE(one, context.tiles());
-    EXPECT_EQ(costly_first(context, context.tiles(), 2, 3), one);
-    EXPECT_EQ(costly_first(context, context.tiles(), 2, 64), one);  // more threads than tiles
+    EXPECT_EQ(costly_first(context, request, context.tiles(), 2, 3), one);
+    EXPECT_EQ(costly_first(context, request, context.tiles(), 2, 64),
+              one);  // more threads than tiles
 }
 
 TEST(CostlyFirst, LeavesOneWorkersTilesAlone) {
     const Scene scene = mirror_ball();
-    const RenderContext context(scene, std::nullopt);
-    EXPECT_EQ(costly_first(context, context.tiles(), 1), context.tiles());
+    const RenderContext context(scene);
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
+    EXPECT_EQ(costly_first(context, request, context.tiles(), 1), context.tiles());
 }
 
 TEST(RenderContext, WithoutTheEstimateRendersTheSamePixelsAndNoneTwice) {
     Scene scene = mirror_ball();
     scene.settings.samples = 4;  // the stratified sampler: calibrated by second renders
-    const RenderContext with(scene, std::nullopt);
-    const RenderContext without(scene, std::nullopt, false);
+    const RenderContext context(scene);
+    const RenderRequest with = RenderRequest::whole_image(scene.settings);
+    RenderRequest without = with;
+    without.estimate_error = false;
     ErrorSums calibrated;
-    for (const Tile& tile : with.tiles()) {
-        const TileBuffer a = with.render_tile(tile);
-        const TileBuffer b = without.render_tile(tile);
+    for (const Tile& tile : context.tiles()) {
+        const TileBuffer a = context.render_tile(tile, with);
+        const TileBuffer b = context.render_tile(tile, without);
         EXPECT_EQ(a.pixels.rgb, b.pixels.rgb) << tile.index;
         EXPECT_EQ(a.rays.total(), b.rays.total()) << tile.index;
         EXPECT_EQ(b.error_sums, ErrorSums{}) << tile.index;
@@ -103,19 +112,30 @@ TEST(RenderContext, WithoutTheEstimateRendersTheSamePixelsAndNoneTwice) {
     EXPECT_GE(calibrated.pixels, 64);  // 8 % of 9,216 pixels rendered twice on average
 }
 
-TEST(RenderContext, APixelBlockRendersOnePixelOfEachSquareAsTheFullRenderDoes) {
+// One pixel in block x block of `scene`'s image.
+RenderRequest one_per_block(const Scene& scene, int block) {
+    RenderRequest request = RenderRequest::whole_image(scene.settings);
+    request.pixels = PixelChoice::kOnePerBlock;
+    request.pixel_block = block;
+    return request;
+}
+
+TEST(RenderContext, OnePixelPerBlockRendersOnePixelOfEachSquareAsTheFullRenderDoes) {
     // 90 x 90 in squares of 4: 22 x 22 whole squares and a row and a column of squares that the
     // image's edge cuts to 2 pixels across.
     Scene scene = testing::scaled_scene("thesis/test1.xml", 90, 4);
     scene.settings.height = 90;
-    const RenderContext full(scene, std::nullopt);
-    const RenderContext pilot(scene, std::nullopt, true, 4);
+    const RenderContext context(scene);
+    const RenderRequest full = RenderRequest::whole_image(scene.settings);
+    const RenderRequest pilot = one_per_block(scene, 4);
     std::uint64_t picked = 0, in_cut_squares = 0;
     for (int sy = 0; sy < 90; sy += 4) {
         for (int sx = 0; sx < 90; sx += 4) {
             int in_square = 0;
             for (int y = sy; y < std::min(sy + 4, 90); ++y) {
-                for (int x = sx; x < std::min(sx + 4, 90); ++x) in_square += pilot.renders(x, y);
+                for (int x = sx; x < std::min(sx + 4, 90); ++x) {
+                    in_square += context.renders(pilot, x, y);
+                }
             }
             // One in a whole square; at most one in a cut square, whose place may lie outside
             // the image, so that every pixel has the same odds.
@@ -128,33 +148,33 @@ TEST(RenderContext, APixelBlockRendersOnePixelOfEachSquareAsTheFullRenderDoes) {
             picked += static_cast<std::uint64_t>(in_square);
         }
     }
-    EXPECT_EQ(pilot.rendered_pixels(), picked);
-    EXPECT_EQ(full.rendered_pixels(), 8100u);
+    EXPECT_EQ(context.rendered_pixels(pilot), picked);
+    EXPECT_EQ(context.rendered_pixels(full), 8100u);
     // 45 cut squares hold 8 (or 4) of their 16 places inside: about 22 picked; 1 in 16 each
     // would make at least 3 and at most 43 all but impossible.
     EXPECT_GE(in_cut_squares, 3u);
     EXPECT_LE(in_cut_squares, 43u);
     // Another seed picks other places: the same as this one's in about 1 square in 16.
-    Scene reseeded = testing::scaled_scene("thesis/test1.xml", 90, 4);
-    reseeded.settings.height = 90;
-    reseeded.settings.seed = scene.settings.seed + 1;
-    const RenderContext other(reseeded, std::nullopt, true, 4);
+    RenderRequest other = pilot;
+    other.seed = pilot.seed + 1;
     int same = 0;
     for (int y = 0; y < 88; ++y) {
-        for (int x = 0; x < 88; ++x) same += pilot.renders(x, y) && other.renders(x, y);
+        for (int x = 0; x < 88; ++x) {
+            same += context.renders(pilot, x, y) && context.renders(other, x, y);
+        }
     }
     EXPECT_LT(same, 484 / 4);
     // A picked pixel has the full render's bits and takes the tile's only samples; the others
     // are 0 with no spread.
     std::uint64_t samples = 0;
-    for (const Tile& tile : full.tiles()) {
-        const TileBuffer a = full.render_tile(tile);
-        const TileBuffer b = pilot.render_tile(tile);
+    for (const Tile& tile : context.tiles()) {
+        const TileBuffer a = context.render_tile(tile, full);
+        const TileBuffer b = context.render_tile(tile, pilot);
         samples += b.samples;
         for (int y = tile.y0; y < tile.y1; ++y) {
             for (int x = tile.x0; x < tile.x1; ++x) {
                 const int tx = x - tile.x0, ty = y - tile.y0;
-                const bool rendered = pilot.renders(x, y);
+                const bool rendered = context.renders(pilot, x, y);
                 EXPECT_EQ(b.pixels.at(tx, ty), rendered ? a.pixels.at(tx, ty) : Color{})
                     << x << " " << y;
                 EXPECT_EQ(b.spread.at(tx, ty), rendered ? a.spread.at(tx, ty) : Color{})
@@ -165,44 +185,49 @@ TEST(RenderContext, APixelBlockRendersOnePixelOfEachSquareAsTheFullRenderDoes) {
     EXPECT_EQ(samples, 4 * picked);
 }
 
-TEST(RenderContext, APilotTileRendersThePickedPixelsOfSquaresThatCrossItsEdges) {
+TEST(RenderContext, OnePixelPerBlockRendersThePickedPixelsOfSquaresThatCrossATilesEdges) {
     // Squares of 5 and 7 do not divide the tiles of 16: a tile holds parts of squares whose
     // picked pixel may lie in it or in a neighbour.
     Scene scene = testing::scaled_scene("thesis/test1.xml", 90, 2);
     scene.settings.height = 61;
+    const RenderContext context(scene);
     for (const int block : {5, 7}) {
-        const RenderContext pilot(scene, std::nullopt, true, block);
+        const RenderRequest pilot = one_per_block(scene, block);
         std::uint64_t rendered = 0;
-        for (const Tile& tile : pilot.tiles()) {
-            const TileBuffer buffer = pilot.render_tile(tile);
+        for (const Tile& tile : context.tiles()) {
+            const TileBuffer buffer = context.render_tile(tile, pilot);
             for (int y = tile.y0; y < tile.y1; ++y) {
                 for (int x = tile.x0; x < tile.x1; ++x) {
                     const std::uint32_t samples =
                         buffer.pixel_samples[std::size_t(y - tile.y0) * std::size_t(tile.width()) +
                                              std::size_t(x - tile.x0)];
-                    EXPECT_EQ(samples, pilot.renders(x, y) ? 2u : 0u)
+                    EXPECT_EQ(samples, context.renders(pilot, x, y) ? 2u : 0u)
                         << block << ": " << x << " " << y;
                     rendered += samples / 2;
                 }
             }
         }
-        EXPECT_EQ(rendered, pilot.rendered_pixels()) << block;
+        EXPECT_EQ(rendered, context.rendered_pixels(pilot)) << block;
     }
 }
 
-TEST(RenderContext, ATopUpRendersItsPixelsTwiceAndAveragesThem) {
+TEST(RenderContext, ListedPixelsPairedAreRenderedTwiceAndAveraged) {
     Scene scene = testing::scaled_scene("thesis/test1.xml", 40, 4);
     scene.settings.height = 30;
     // Pixels in three tiles, a corner and an edge among them.
     const std::vector<std::uint32_t> top_up{0, 17, 39, 40 * 16 + 20, 40 * 29 + 39};
-    const RenderContext full(scene, std::nullopt);
-    const RenderContext again(scene, std::nullopt, true, 1, top_up);
-    EXPECT_EQ(again.rendered_pixels(), top_up.size());
+    const RenderContext context(scene);
+    const RenderRequest full = RenderRequest::whole_image(scene.settings);
+    RenderRequest again = full;
+    again.pixels = PixelChoice::kListed;
+    again.listed = top_up;
+    again.paired = true;
+    EXPECT_EQ(context.rendered_pixels(again), top_up.size());
     std::uint64_t samples = 0;
     double pairs = 0;
-    for (const Tile& tile : full.tiles()) {
-        const TileBuffer a = full.render_tile(tile);
-        const TileBuffer b = again.render_tile(tile);
+    for (const Tile& tile : context.tiles()) {
+        const TileBuffer a = context.render_tile(tile, full);
+        const TileBuffer b = context.render_tile(tile, again);
         samples += b.samples;
         pairs += b.error_sums.pixels;
         for (int y = tile.y0; y < tile.y1; ++y) {
@@ -210,7 +235,7 @@ TEST(RenderContext, ATopUpRendersItsPixelsTwiceAndAveragesThem) {
                 const int tx = x - tile.x0, ty = y - tile.y0;
                 const auto i = static_cast<std::uint32_t>(y * 40 + x);
                 const bool listed = std::find(top_up.begin(), top_up.end(), i) != top_up.end();
-                EXPECT_EQ(again.renders(x, y), listed) << x << " " << y;
+                EXPECT_EQ(context.renders(again, x, y), listed) << x << " " << y;
                 if (!listed) {
                     EXPECT_EQ(b.pixels.at(tx, ty), Color{}) << x << " " << y;
                     continue;
@@ -233,13 +258,54 @@ TEST(RenderContext, ATopUpRendersItsPixelsTwiceAndAveragesThem) {
     }
     EXPECT_EQ(samples, 8 * top_up.size());
     // The spreads are the variance of the pairs' means: nothing to calibrate.
-    EXPECT_EQ(again.spread_kind(), SpreadKind::kIndependent);
+    EXPECT_EQ(context.spread_kind(again), SpreadKind::kIndependent);
     EXPECT_EQ(pairs, 0.0);
-    EXPECT_THROW(RenderContext(scene, std::nullopt, true, 1, std::vector<std::uint32_t>{3, 3}),
-                 std::invalid_argument);
-    EXPECT_THROW(RenderContext(scene, std::nullopt, true, 1, std::vector<std::uint32_t>{1200}),
-                 std::invalid_argument);
-    EXPECT_THROW(RenderContext(scene, std::nullopt, true, 4, top_up), std::invalid_argument);
+}
+
+TEST(RenderContext, ChecksARequestBeforeRenderingIt) {
+    Scene scene = testing::scaled_scene("thesis/test1.xml", 40, 4);
+    scene.settings.height = 30;
+    const RenderContext context(scene);
+    RenderRequest request = RenderRequest::whole_image(scene.settings);
+    EXPECT_NO_THROW(context.check(request));
+    request.samples = 0;
+    EXPECT_THROW(context.check(request), std::invalid_argument);
+    request = one_per_block(scene, 1);
+    EXPECT_THROW(context.check(request), std::invalid_argument);
+    request = RenderRequest::whole_image(scene.settings);
+    request.pixels = PixelChoice::kListed;
+    for (const auto& listed : std::vector<std::vector<std::uint32_t>>{{3, 3}, {5, 4}, {1200}}) {
+        request.listed = listed;
+        EXPECT_THROW(context.check(request), std::invalid_argument);
+    }
+    request.listed = {0, 1199};
+    EXPECT_NO_THROW(context.check(request));
+}
+
+// Requests of other counts and seeds against one context: each the bits of a context set up for
+// the scene with those settings, one sample per pixel (the pixel centre) included.
+TEST(RenderContext, ARequestAgainstOneContextIsTheFreshRenderOfItsSettings) {
+    Scene scene = testing::scaled_scene("thesis/test1.xml", 40, 4);
+    scene.settings.height = 30;
+    const RenderContext context(scene);
+    for (const auto& [samples, seed] :
+         std::vector<std::pair<int, std::uint64_t>>{{4, 0}, {1, 7}, {9, 123456789}, {2, 5}}) {
+        Scene fresh = testing::scaled_scene("thesis/test1.xml", 40, 4);
+        fresh.settings.height = 30;
+        fresh.settings.samples = samples;
+        fresh.settings.seed = seed;
+        const RenderContext alone(fresh);
+        const RenderRequest own = RenderRequest::whole_image(fresh.settings);
+        EXPECT_EQ(context.plan(own).effects.antialiasing, samples > 1);
+        EXPECT_EQ(context.plan(own).effects.antialiasing, plan_render(fresh).effects.antialiasing);
+        for (const Tile& tile : context.tiles()) {
+            const TileBuffer a = context.render_tile(tile, own);
+            const TileBuffer b = alone.render_tile(tile, own);
+            ASSERT_EQ(a.pixels.rgb, b.pixels.rgb) << samples << " " << tile.index;
+            ASSERT_EQ(a.spread.rgb, b.spread.rgb) << samples << " " << tile.index;
+            ASSERT_EQ(a.error_sums, b.error_sums) << samples << " " << tile.index;
+        }
+    }
 }
 
 }  // namespace

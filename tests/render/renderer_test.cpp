@@ -56,11 +56,12 @@ TEST(TileGrid, CutsTheImageRowByRowWithSmallerTilesAtTheEdges) {
 
 TEST(ImageSink, RefusesATileTwiceAndATileOfAnotherGrid) {
     const Scene scene = small_scene("thesis/test6.xml", 20);
-    const RenderContext context(scene, std::nullopt);
+    const RenderContext context(scene);
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
     ImageSink sink(scene.settings.width, scene.settings.height, context.tiles());
-    sink.add(context.render_tile(context.tiles()[0]));
-    EXPECT_THROW(sink.add(context.render_tile(context.tiles()[0])), std::logic_error);
-    TileBuffer other = context.render_tile(context.tiles()[1]);
+    sink.add(context.render_tile(context.tiles()[0], request));
+    EXPECT_THROW(sink.add(context.render_tile(context.tiles()[0], request)), std::logic_error);
+    TileBuffer other = context.render_tile(context.tiles()[1], request);
     other.tile.x1 -= 1;
     EXPECT_THROW(sink.add(std::move(other)), std::invalid_argument);
     EXPECT_EQ(sink.tiles_done(), 1u);
@@ -72,13 +73,14 @@ TEST(Renderer, TilesInAnyOrderGiveTheWholeRendersBits) {
         SCOPED_TRACE(name);
         const Scene scene = small_scene(name, 72);
         const RenderResult whole = render(scene, on_threads(2));
-        const RenderContext context(scene, std::nullopt);
+        const RenderContext context(scene);
+        const RenderRequest request = RenderRequest::whole_image(scene.settings);
         ASSERT_GT(context.tiles().size(), 4u);
         std::vector<Tile> order = context.tiles();
         std::shuffle(order.begin(), order.end(), std::mt19937(7));
         ImageSink sink(scene.settings.width, scene.settings.height, context.tiles());
         TileQueue source(order);
-        EXPECT_EQ(render_tiles(context, source, sink, on_threads(1)), 1);
+        EXPECT_EQ(render_tiles(context, request, source, sink, on_threads(1)), 1);
         EXPECT_TRUE(same_bits(sink.image(), whole.image));
         expect_same_counts(sink.rays(), whole.stats.rays);
         EXPECT_EQ(sink.samples(), whole.stats.samples);
@@ -90,11 +92,12 @@ TEST(Renderer, TileBuffersRayCountsSumToTheWholeRenders) {
         SCOPED_TRACE(name);
         const Scene scene = small_scene(name, 72);
         const RenderResult whole = render(scene, on_threads(2));
-        const RenderContext context(scene, std::nullopt);
+        const RenderContext context(scene);
+        const RenderRequest request = RenderRequest::whole_image(scene.settings);
         RayCounts sum;
         std::uint64_t samples = 0;
         for (const Tile& tile : context.tiles()) {
-            const TileBuffer buffer = context.render_tile(tile);
+            const TileBuffer buffer = context.render_tile(tile, request);
             EXPECT_GT(buffer.rays.camera, 0u);
             sum += buffer.rays;
             samples += buffer.samples;
@@ -116,16 +119,18 @@ TEST(Renderer, ASubsetThenTheRestGiveTheWholeRendersBits) {
         if (adaptive) options.adaptive = AdaptiveSampling{0.01, 4};
         const RenderResult whole = render(scene, options);
 
-        const RenderContext context(scene, options.adaptive);
+        const RenderContext context(scene);
+        RenderRequest request = RenderRequest::whole_image(scene.settings);
+        request.adaptive = options.adaptive;
         ImageSink sink(scene.settings.width, scene.settings.height, context.tiles());
         std::vector<Tile> every_third;
         for (const Tile& t : context.tiles()) {
             if (t.index % 3 == 1) every_third.push_back(t);
         }
         TileQueue first(every_third);
-        render_tiles(context, first, sink, options);
+        render_tiles(context, request, first, sink, options);
         EXPECT_EQ(sink.missing().size(), context.tiles().size() - every_third.size());
-        const RenderResult rest = render(context, sink, options);
+        const RenderResult rest = complete_render(context, request, sink, options);
 
         EXPECT_TRUE(same_bits(rest.image, whole.image));
         expect_same_counts(rest.stats.rays, whole.stats.rays);
@@ -162,14 +167,15 @@ class StopAfter final : public TileSink {
 TEST(Renderer, AStopLeavesWholeTilesDoneAndTheRestUntouched) {
     const Scene scene = small_scene("thesis/test6.xml", 72);
     const RenderResult whole = render(scene, on_threads(2));
-    const RenderContext context(scene, std::nullopt);
+    const RenderContext context(scene);
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
     ImageSink sink(scene.settings.width, scene.settings.height, context.tiles());
     std::stop_source stop;
     StopAfter stopping(sink, stop, 3);
     TileQueue source(context.tiles());
     RenderOptions options = on_threads(2);
     options.stop = stop.get_token();
-    render_tiles(context, source, stopping, options);
+    render_tiles(context, request, source, stopping, options);
 
     // The other worker finishes the tile it holds when the stop comes, and takes no other.
     const std::vector<Tile> missing = sink.missing();
@@ -179,7 +185,7 @@ TEST(Renderer, AStopLeavesWholeTilesDoneAndTheRestUntouched) {
     RayCounts expected_rays;
     for (const Tile& t : context.tiles()) {
         const bool is_missing = std::find(missing.begin(), missing.end(), t) != missing.end();
-        if (!is_missing) expected_rays += context.render_tile(t).rays;
+        if (!is_missing) expected_rays += context.render_tile(t, request).rays;
         for (int y = t.y0; y < t.y1; ++y) {
             for (int x = t.x0; x < t.x1; ++x) {
                 const Color want = is_missing ? Color{} : whole.image.at(x, y);
@@ -190,7 +196,7 @@ TEST(Renderer, AStopLeavesWholeTilesDoneAndTheRestUntouched) {
     expect_same_counts(sink.rays(), expected_rays);
 
     // Resumed from the finished tiles: the rest are rendered, and the image is the whole one.
-    const RenderResult resumed = render(context, sink, on_threads(2));
+    const RenderResult resumed = complete_render(context, request, sink, on_threads(2));
     EXPECT_TRUE(same_bits(resumed.image, whole.image));
     expect_same_counts(resumed.stats.rays, whole.stats.rays);
 }
@@ -255,13 +261,14 @@ class FailingSink final : public TileSink {
 
 TEST(Renderer, AnExceptionInAWorkerStopsTheOthersAndIsRethrown) {
     const Scene scene = testing::floor_scene(160, 64);
-    const RenderContext context(scene, std::nullopt);
+    const RenderContext context(scene);
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
     ASSERT_EQ(context.tiles().size(), 40u);
     for (const int threads : {1, 2}) {
         CountingSource source(context.tiles());
         FailingSink sink;
         try {
-            render_tiles(context, source, sink, on_threads(threads));
+            render_tiles(context, request, source, sink, on_threads(threads));
             ADD_FAILURE() << "no exception";
         } catch (const std::runtime_error& e) {
             EXPECT_STREQ(e.what(), "sink failed on tile 2");
@@ -277,15 +284,16 @@ TEST(Renderer, AnExceptionInAWorkerStopsTheOthersAndIsRethrown) {
 
 TEST(Renderer, ProgressEndsAtOneAndCountsTilesAlreadyDone) {
     const Scene scene = small_scene("thesis/test6.xml", 40);
-    const RenderContext context(scene, std::nullopt);
+    const RenderContext context(scene);
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
     ImageSink sink(scene.settings.width, scene.settings.height, context.tiles());
     const std::size_t n = context.tiles().size();
     ASSERT_EQ(n, 6u);
-    for (std::size_t i = 0; i < 3; ++i) sink.add(context.render_tile(context.tiles()[i]));
+    for (std::size_t i = 0; i < 3; ++i) sink.add(context.render_tile(context.tiles()[i], request));
     std::vector<double> reported;
     RenderOptions options = on_threads(1);
     options.on_progress = [&](double done) { reported.push_back(done); };
-    render(context, sink, options);
+    complete_render(context, request, sink, options);
     ASSERT_FALSE(reported.empty());
     EXPECT_GE(reported.front(), 0.5);
     EXPECT_EQ(reported.back(), 1.0);

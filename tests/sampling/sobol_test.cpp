@@ -227,9 +227,9 @@ TEST(SamplerSobol, PixelAreaAndLensAreStratifiedTogether) {
 
 TEST(SamplerSobol, MoreSamplesContinueTheSamePattern) {
     const SobolSampler sampler;
-    EXPECT_TRUE(sampler.progressive());
-    EXPECT_FALSE(StratifiedSampler().progressive());
-    EXPECT_FALSE(IndependentSampler().progressive());
+    EXPECT_TRUE(sampler.extensible());
+    EXPECT_FALSE(StratifiedSampler().extensible());
+    EXPECT_FALSE(IndependentSampler().extensible());
     for (std::uint32_t index = 0; index < 16; ++index) {
         const Vec2 a = sampler.get_2d({4, 8, index, 16}, dim::kLens);
         const Vec2 b = sampler.get_2d({4, 8, index, 64}, dim::kLens);

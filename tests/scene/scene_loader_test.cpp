@@ -1063,6 +1063,20 @@ TEST_F(SceneFile, ZeroAreaTrianglesOfAMeshAreCountedInOneWarning) {
                                        (dir_ / "m.obj").string() + " dropped"});
 }
 
+// A needle with area in the file that single precision flattens onto a line has no normal: it
+// is left out, and said so apart from the zero-area ones.
+TEST_F(SceneFile, TrianglesFlattenedBySinglePrecisionAreCountedInTheirOwnWarning) {
+    write("m.obj", std::string(kTetrahedron) + "v 0 0 0\nv 1 1 0\nv 3 3.0000000001 0\nf 5 6 7\n");
+    const std::string s = write("s.xml",
+                                "<Scene><Materials><Gray/></Materials>\n"
+                                "<Mesh File=\"m.obj\" Material=\"Gray\"/></Scene>\n");
+    const LoadedScene loaded = load_scene(s);
+    EXPECT_EQ(mesh(loaded.scene, 0).mesh().triangle_count(), 4u);
+    EXPECT_EQ(loaded.warnings, std::vector<std::string>{s + ":2: warning: 1 triangle in " +
+                                                        (dir_ / "m.obj").string() +
+                                                        " too thin for single precision dropped"});
+}
+
 }  // namespace
 }  // namespace drt
 

@@ -58,13 +58,13 @@ double loglog_slope(const std::vector<double>& x, const std::vector<double>& y);
 int default_reference_spp(const std::vector<int>& spps);
 std::uint64_t reference_seed(std::uint64_t seed);
 
-// Renders the scene with `spp` samples and `seed` instead of its own (restored afterwards).
-RenderResult render_with(Scene& scene, int spp, std::uint64_t seed, const RenderOptions& options);
+// The whole image at `spp` samples and `seed` instead of the scene's, with options.adaptive.
+RenderRequest request_at(int spp, std::uint64_t seed, const RenderOptions& options);
 
 // Renders the scene at each count in `spps` with its own seed and measures each image against
 // `reference`; `on_point` sees each point as soon as it is measured.
-Convergence measure_convergence(Scene& scene, const std::vector<int>& spps, const Image& reference,
-                                const RenderOptions& options,
+Convergence measure_convergence(const Scene& scene, const std::vector<int>& spps,
+                                const Image& reference, const RenderOptions& options,
                                 const std::function<void(const ConvergencePoint&)>& on_point = {});
 
 // Where the measured RMSE falls to `target`: the samples and seconds interpolated log-log

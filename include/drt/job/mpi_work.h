@@ -15,6 +15,7 @@
 
 #include "drt/job/transport.h"
 #include "drt/render/render_context.h"
+#include "drt/render/render_request.h"
 #include "drt/render/renderer.h"
 #include "drt/render/tile.h"
 
@@ -36,12 +37,12 @@ bool launched_by_mpirun(const std::function<const char*(const char*)>& getenv = 
 // processes there).
 bool bound_by_mpirun_default(const std::function<const char*(const char*)>& getenv = std::getenv);
 
-// What MpiJob::render did on this process.
+// What MpiJob::render_tiles did on this process.
 struct MpiShare {
     int threads = 0;  // worker threads of this process
     // Leader only: when its queue handed out the last tile (the start of the render's tail), and
     // the finished tiles other processes sent, with the time its communication thread spent
-    // receiving them and adding them to the image (the per-message cost in docs/scale-out.md).
+    // receiving them and adding them to the image.
     std::optional<std::chrono::steady_clock::time_point> emptied;
     std::uint64_t messages = 0;
     double receive_seconds = 0, assemble_seconds = 0;
@@ -65,19 +66,20 @@ class MpiJob {
     int local_size() const { return transport_->local_size(); }
 
     // The leader's value, on every process (collective).
-    int leaders(int value) const;
+    int broadcast(int value) const;
     // The leader's values, on every process (collective): the leader sends them to each.
-    std::vector<std::uint32_t> leaders(std::vector<std::uint32_t> values) const;
+    std::vector<std::uint32_t> broadcast(std::vector<std::uint32_t> values) const;
     // The highest of every process's value, on every process (collective).
     int highest(int value) const;
 
-    // Renders the tiles `todo` of `context` across all processes (collective). On the leader,
+    // Renders the tiles `todo` of `request` across all processes (collective). On the leader,
     // every finished tile goes to `sink`; elsewhere `todo` and `sink` are not used. A stop
     // requested on a process ends its share: the leader then hands out nothing more, and
     // another process gives back the tiles it was handed but did not render. Tiles are handed
     // out in the order of `todo`.
-    MpiShare render(const RenderContext& context, std::vector<Tile> todo, TileSink& sink,
-                    const RenderOptions& options) const;
+    MpiShare render_tiles(const RenderContext& context, const RenderRequest& request,
+                          std::vector<Tile> todo, TileSink& sink,
+                          const RenderOptions& options) const;
 
   private:
     // Declared first, so destroyed last: the transport's code lives in the module.

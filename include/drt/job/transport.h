@@ -38,7 +38,7 @@ class Transport {
     // Processes of this job on this machine, this one included: they share its cores.
     virtual int local_size() const = 0;
     // The leader's (rank 0's) value, on every process.
-    virtual int leaders(int value) const = 0;
+    virtual int broadcast(int value) const = 0;
     // The highest of every process's value, on every process.
     virtual int highest(int value) const = 0;
     // Returns once `bytes` may be reused: for a message above MPI's eager limit (Open MPI's

@@ -5,7 +5,7 @@
 // Each pixel keeps a spread per channel, a guess at the variance of its mean. For independent
 // samples (the random sampler) it is their sample variance over n (pixel_spread), which is that
 // variance. For a stratified or Sobol pattern the sample variance ignores the stratification and
-// overstated the error by 1.3 to 10x (docs/accuracy.md); their spread is the strata spread
+// overstates the error several times; their spread is the strata spread
 // (strata_spread), from differences of neighbouring strata, which credits the stratification but
 // cannot see correlations between strata. There the spread only says where the error is, and the
 // image calibrates how large it is: a few pixels of each tile, chosen at random with odds that
@@ -42,16 +42,13 @@ enum class SpreadKind { kIndependent, kCalibrated };
 inline constexpr double kCalibrationShare = 0.08;
 // A calibration of this many pixels pins the estimate's scale to a few per cent (the relative
 // spread of a variance from N independent differences is about sqrt(2 / N)); more would only
-// add cost, so a large image renders this many twice rather than kCalibrationShare of its
-// pixels (800 x 600: 0.9 % instead of 8 %).
+// add cost, so a large image renders this many twice rather than kCalibrationShare of its pixels.
 inline constexpr double kMaxCalibrationPixels = 4096;
 // Fewer pixels rendered twice than this leave the calibration too noisy to state a number.
 inline constexpr double kMinCalibrationPixels = 24;
-// A small image renders at least this many pixels twice (all of them below it). The
+// A small image renders at least this many pixels twice (all of them below it): the
 // calibration's noise depends on how many pixels it takes, not on their share, and a small
-// image's error sits in few pixels: at 48 x 36 (aa-10spp, stratified 256 spp, 10 seeds) the
-// estimate ranged over 0.74-1.41 of the true RMSE with 8 % (~140 pixels), 0.91-1.14 with 512
-// (docs/accuracy.md). It costs 30 % more samples there and nothing above 6,400 pixels.
+// image's error sits in few pixels.
 inline constexpr double kMinSmallImageCalibration = 512;
 // The share for an image of `pixels` pixels: kCalibrationShare, capped at kMaxCalibrationPixels
 // pixels, or more for a small image, so that kMinSmallImageCalibration pixels are rendered twice
@@ -90,18 +87,26 @@ struct StrataScratch {
 // n is the variance of the mean if every stratum had that variance. A smooth gradient cancels,
 // unlike in the sample variance, which counts it whole and so overstated an edge's stratified
 // error about sqrt(n)-fold; an edge across a band counts about twice its variance, one along a
-// band once. The calibration then scales what is left (docs/accuracy.md). Infinite for fewer than
-// two samples.
+// band once. The calibration then scales what is left. Infinite for fewer than two samples.
 Color strata_spread(std::span<const Vec2> positions, std::span<const Color> samples,
                     StrataScratch& scratch);
 
+// For each pixel of a width x height image of `values` (row by row), the largest value among its
+// (up to) 8 neighbours, and with kWithSelf its own too: a pixel whose few samples all fell on one
+// side of an edge shows no spread, though its neighbours along the edge do.
+enum class Around { kWithSelf, kNeighboursOnly };
+std::vector<double> largest_around(std::span<const double> values, int width, int height,
+                                   Around which);
+
+// The odds of picking a pixel when `scale` picks go a quarter equally (`even`, each pixel's part
+// of that quarter as a share of the unit) and three quarters in proportion to the pixel's
+// `weight` out of `total`; at most 1. Every pixel keeps some odds, so sums weighted by 1 / odds
+// stay unbiased, and the pixels that carry most of the error are picked most often.
+double pick_odds(double scale, double even, double weight, double total);
+
 // For each pixel of a tile (its spread image, row by row), the odds of rendering it a second
-// time: `share` on average over the tile, a quarter of them shared equally and the rest in
-// proportion to the largest spread of the pixel and its (up to 8) neighbours in the tile, at
-// most 1. Pixels where the samples spread more carry most of the error, so the calibration looks
-// there most often; the neighbours count because a pixel of few samples can miss the edge that
-// crosses it (no spread, yet a large error) while its neighbours along the edge show it. Every
-// pixel keeps some odds, so the weighted sums stay unbiased.
+// time: `share` on average over the tile, by pick_odds with the largest spread (summed over
+// channels) of the pixel and its neighbours in the tile as the weight (largest_around).
 std::vector<double> calibration_odds(const Image& spread, double share);
 
 // Adds a pixel rendered twice: `first` the image's mean and `spread` its spread, `second` the
@@ -127,7 +132,7 @@ struct ErrorEstimate {
 // variance (at least 0) for the unknown ref^2. `spp` is the samples per pixel asked for: with 1
 // the pixel centre is taken and nothing can be estimated. Where no sample of any pixel spread and
 // no pixel rendered twice differed, the estimate is 0 however few were rendered twice. `pixels`
-// is how many pixels were rendered, the others left 0 (a pilot's, render_context.h): the mean is
+// is how many pixels were rendered, the others left 0 (render_request.h): the mean is
 // theirs; 0 for all. Throws ImageError when the sizes differ.
 ErrorEstimate estimate_error(const Image& image, const Image& spread, const ErrorSums& sums,
                              std::uint64_t samples, int spp, SpreadKind kind,

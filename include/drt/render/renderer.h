@@ -1,7 +1,7 @@
 // Renders a scene into an image: tiles from a TileSource rendered by worker threads
 // (RenderContext::render_tile) and handed to a TileSink. Each pixel is a pure function of the
-// scene, the options and the seed, so the image never depends on the thread count, the order of
-// the tiles or which process rendered them.
+// scene and the request (render_request.h), so the image never depends on the thread count, the
+// order of the tiles or which process rendered them.
 #pragma once
 
 #include <cstdint>
@@ -15,6 +15,7 @@
 #include "drt/render/integrator.h"
 #include "drt/render/render_context.h"
 #include "drt/render/render_plan.h"
+#include "drt/render/render_request.h"
 #include "drt/render/tile.h"
 #include "drt/scene/scene.h"
 
@@ -24,7 +25,9 @@ struct RenderOptions {
     int threads = 0;  // 0 = all cores
     // Called now and then from the rendering thread with the fraction done (0..1).
     std::function<void(double)> on_progress;
-    std::optional<AdaptiveSampling> adaptive;  // absent: every pixel takes the scene's samples
+    // For render(scene, options) alone (a request says its own): absent, every pixel takes the
+    // scene's samples.
+    std::optional<AdaptiveSampling> adaptive;
     // Checked between tiles: once a stop is requested, each worker finishes the tile in hand and
     // takes no other, so only whole tiles are done (RenderResult::unfinished lists the rest).
     std::stop_token stop;
@@ -32,8 +35,8 @@ struct RenderOptions {
 
 struct RenderStats {
     double seconds = 0;
-    // Of those, what went before and after rendering the tiles (building the context, ordering
-    // the tiles, assembling the image). Set by run_render_job (render_job.h).
+    // Of those, what went before and after rendering the tiles (building the context where the
+    // render built one, ordering the tiles, assembling the image). Set by run_render_job.
     double setup_seconds = 0;
     int threads = 1;    // worker threads of one process
     int processes = 1;  // processes of an MPI job (mpi_work.h)
@@ -66,24 +69,29 @@ struct RenderResult {
     std::vector<Tile> unfinished;
 };
 
-// The whole image.
+// The whole image at the scene's samples and seed, with options.adaptive.
 RenderResult render(const Scene& scene, const RenderOptions& options);
+// `request` on `scene` set up for it alone; options.adaptive is ignored: the request's applies.
+RenderResult render(const Scene& scene, const RenderRequest& request, const RenderOptions& options);
 
-// The tiles `sink` does not have yet, then the result of all of them: a render resumed from
-// tiles finished earlier (added to the sink first) gives the same bits as one never stopped.
-// options.adaptive is ignored: the context's applies.
-RenderResult render(const RenderContext& context, ImageSink& sink, const RenderOptions& options);
+// The tiles of `request` that `sink` does not have yet, then the result of all of them: a render
+// resumed from tiles finished earlier (added to the sink first) gives the same bits as one never
+// stopped. options.adaptive is ignored: the request's applies.
+RenderResult complete_render(const RenderContext& context, const RenderRequest& request,
+                             ImageSink& sink, const RenderOptions& options);
 
-// What the tiles in `sink` make: the image, the per-pixel sample counts and spreads, the
-// totals, the error estimate and the tiles still missing (stats.seconds and stats.threads are left
-// for the caller).
-RenderResult assembled(const RenderContext& context, const ImageSink& sink);
+// What the tiles of `request` in `sink` make: the image, the per-pixel sample counts and spreads,
+// the totals, the error estimate and the tiles still missing (stats.seconds and stats.threads are
+// left for the caller).
+RenderResult assembled(const RenderContext& context, const RenderRequest& request,
+                       const ImageSink& sink);
 
-// Renders tiles from `source` on options.threads workers (capped at source.size()) into `sink`
-// until the source runs dry or a stop is requested. An exception in a worker (from the source,
-// the tile or the sink) stops the other workers after their tile in hand and is rethrown here.
-// options.on_progress gets the fraction of source.size() done. Returns the threads used.
-int render_tiles(const RenderContext& context, TileSource& source, TileSink& sink,
-                 const RenderOptions& options);
+// Renders tiles of `request` from `source` on options.threads workers (capped at source.size())
+// into `sink` until the source runs dry or a stop is requested. Throws std::invalid_argument for
+// a request the context cannot render (RenderContext::check). An exception in a worker (from the
+// source, the tile or the sink) stops the other workers after their tile in hand and is rethrown
+// here. options.on_progress gets the fraction of source.size() done. Returns the threads used.
+int render_tiles(const RenderContext& context, const RenderRequest& request, TileSource& source,
+                 TileSink& sink, const RenderOptions& options);
 
 }  // namespace drt

@@ -76,7 +76,7 @@ class Sampler {
     // True when a pixel's samples form one sequence that ignores PixelSample::count: samples
     // count .. 2*count-1 then refine the pattern of the first count instead of repeating it, so
     // a renderer may add samples to a pixel by continuing the index.
-    virtual bool progressive() const { return false; }
+    virtual bool extensible() const { return false; }
     // True when every number is independent of every other: a pixel's samples are then
     // independent, and their sample variance over n is the variance of their mean.
     virtual bool independent() const { return false; }

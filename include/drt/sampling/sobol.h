@@ -31,7 +31,7 @@ class SobolSampler final : public Sampler {
                        std::uint32_t k) const override;
     void get_2d_set(const PixelSample& s, std::uint32_t dim, std::uint32_t k, std::uint32_t first,
                     std::span<Vec2> out) const override;
-    bool progressive() const override { return true; }
+    bool extensible() const override { return true; }
 };
 
 // A keyed permutation of 32-bit words standing in for Owen's nested uniform scrambling of base-2

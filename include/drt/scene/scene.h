@@ -62,17 +62,4 @@ struct Scene {
     const Material* find_material(const std::string& name) const;
 };
 
-// Restores a scene's settings however the render that changed them ends.
-class SettingsGuard {
-  public:
-    explicit SettingsGuard(Scene& scene) : scene_(scene), saved_(scene.settings) {}
-    ~SettingsGuard() { scene_.settings = saved_; }
-    SettingsGuard(const SettingsGuard&) = delete;
-    SettingsGuard& operator=(const SettingsGuard&) = delete;
-
-  private:
-    Scene& scene_;
-    RenderSettings saved_;
-};
-
 }  // namespace drt

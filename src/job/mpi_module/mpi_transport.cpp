@@ -74,7 +74,7 @@ class MpiTransport final : public Transport {
     int size() const override { return size_; }
     int local_size() const override { return local_size_; }
 
-    int leaders(int value) const override {
+    int broadcast(int value) const override {
         check(MPI_Bcast(&value, 1, MPI_INT, 0, MPI_COMM_WORLD), "broadcast");
         return value;
     }

@@ -1,6 +1,6 @@
-// Rendering to a goal (progressive.h): the prediction's arithmetic, and --target-error and
+// Rendering to a goal (goal_render.h): the prediction's arithmetic, and --target-error and
 // --time-limit as a user runs them.
-#include "drt/goal/progressive.h"
+#include "drt/goal/goal_render.h"
 
 #include <gtest/gtest.h>
 
@@ -41,6 +41,14 @@ double combined(std::initializer_list<double> errors) {
     return 1 / std::sqrt(inverse);
 }
 
+// The whole image at `spp` samples and `seed`: a round rendered alone.
+RenderRequest alone_at(int spp, std::uint64_t seed) {
+    RenderRequest request;
+    request.samples = spp;
+    request.seed = seed;
+    return request;
+}
+
 // The error one more round must have for rounds combined to `c` to reach 98 % of `target`.
 double wanted(double target, double c) {
     const double goal = 0.98 * target;
@@ -67,7 +75,7 @@ TEST(Predict, FromOneRoundAlongTheSteepestSlope) {
     // One pilot at 0.04 against a target of 0.01: one more round must have the error
     // 1 / sqrt(1 / 0.0098^2 - 1 / 0.04^2) = 0.010108, which along -1 is 8 * 0.04 / 0.010108 =
     // 31.66 samples.
-    const std::vector<ProgressiveRound> one{{8, 1.0, 0.04, 0.04}};
+    const std::vector<GoalRound> one{{8, 1.0, 0.04, 0.04}};
     const auto p = predict(one, 0.01, 65536);
     ASSERT_TRUE(p);
     EXPECT_NEAR(8 * 0.04 / wanted(0.01, 0.04), 31.66, 0.01);
@@ -89,7 +97,7 @@ TEST(Predict, TakesTheSlopeOverAtLeastThreefoldTheSamplesHeldBetweenMinusOneAndA
     // round needs the error wanted(0.01, 0.0358) = 0.0102: 32 * (0.04 / 0.0102)^2 = 493.1.
     const double c = combined({0.08, 0.04});
     EXPECT_NEAR(c, 0.0358, 1e-4);
-    const std::vector<ProgressiveRound> rounds{{8, 1.0, 0.08, std::nullopt}, {32, 2.5, 0.04, c}};
+    const std::vector<GoalRound> rounds{{8, 1.0, 0.08, std::nullopt}, {32, 2.5, 0.04, c}};
     const auto p = predict(rounds, 0.01, 65536);
     ASSERT_TRUE(p);
     EXPECT_NEAR(32 * std::pow(0.04 / wanted(0.01, c), 2), 493.1, 0.1);
@@ -101,15 +109,15 @@ TEST(Predict, TakesTheSlopeOverAtLeastThreefoldTheSamplesHeldBetweenMinusOneAndA
     EXPECT_EQ(predict({{8, 1, 0.08, std::nullopt}, {32, 2, 0.08, flat}}, 0.02, 65536)->spp, 6878);
     // A slope of -2 (luck) is taken as -1: 32 * 0.01 / wanted(0.005, 0.00998) = 56.9; held at
     // -1/2, 32 * (0.01 / wanted)^2 = 101.2.
-    const std::vector<ProgressiveRound> steep{{8, 1, 0.16, std::nullopt},
-                                              {32, 2, 0.01, combined({0.16, 0.01})}};
+    const std::vector<GoalRound> steep{{8, 1, 0.16, std::nullopt},
+                                       {32, 2, 0.01, combined({0.16, 0.01})}};
     EXPECT_EQ(predict(steep, 0.005, 65536)->spp, 57);
     EXPECT_EQ(predict(steep, 0.005, 65536, -0.5)->spp, 102);
     // 100 to 120 samples is too narrow a span to measure a slope (their -0.1 would be taken as
     // -1/4): the steepest, -1, from the larger round, as from one round: 120 * 0.011 / 0.00627 =
     // 210.4 (along -1/4, 1135).
-    const std::vector<ProgressiveRound> narrow{{100, 1, 0.0112, std::nullopt},
-                                               {120, 1, 0.011, combined({0.0112, 0.011})}};
+    const std::vector<GoalRound> narrow{{100, 1, 0.0112, std::nullopt},
+                                        {120, 1, 0.011, combined({0.0112, 0.011})}};
     EXPECT_NEAR(120 * 0.011 / wanted(0.005, combined({0.0112, 0.011})), 210.4, 0.05);
     EXPECT_EQ(predict(narrow, 0.005, 65536)->spp, 211);
 }
@@ -122,7 +130,7 @@ TEST(Predict, ARoundSmallerThanTheLargestAlongThreeQuarters) {
     EXPECT_EQ(predict({{40, 1, 0.0102, 0.0102}}, 0.01, 65536)->spp, 8);
     // The largest round is extrapolated from, not the latest; along -3/4 whatever the slope
     // measured from 8 to 40 samples (-0.67 here): 40 * (0.0421 / 0.0102)^(-4/3) = 6.36.
-    const std::vector<ProgressiveRound> rounds{
+    const std::vector<GoalRound> rounds{
         {8, 1, 0.03, std::nullopt}, {40, 1, 0.0102, std::nullopt}, {12, 1, 0.05, 0.0101}};
     EXPECT_NEAR(40 * std::pow(wanted(0.01, 0.0101) / 0.0102, -4.0 / 3), 6.36, 0.01);
     EXPECT_EQ(predict(rounds, 0.01, 65536)->spp, 7);
@@ -136,7 +144,7 @@ TEST(Predict, NeedsARoundWithAPositiveEstimate) {
 }
 
 TEST(NextRound, ThePredictedCountWhenWithinTheFinalStep) {
-    const std::vector<ProgressiveRound> one{{8, 1.0, 0.04, 0.04}};
+    const std::vector<GoalRound> one{{8, 1.0, 0.04, 0.04}};
     const NextRound n = next_round(one, 0.01, 65536);
     EXPECT_EQ(n.spp, 32);
     EXPECT_TRUE(n.final);
@@ -166,7 +174,7 @@ TEST(NextRound, AtLeastATenthOfTheSamplesSoFarAndTwo) {
     // Eight rounds of 25 samples at 0.02829 combine to 0.010002, just over 0.01: one more round of
     // 25 * (wanted(0.01, 0.010002) / 0.02829)^(-4/3) = 12.02 samples would do, raised to a tenth
     // of 200.
-    const std::vector<ProgressiveRound> eight(
+    const std::vector<GoalRound> eight(
         8, {25, 1, 0.02829,
             combined({0.02829, 0.02829, 0.02829, 0.02829, 0.02829, 0.02829, 0.02829, 0.02829})});
     EXPECT_EQ(predict(eight, 0.01, 65536)->spp, 13);
@@ -179,17 +187,16 @@ TEST(NextRound, AfterAFinalRoundThatMissedASlopeNoSteeperThanMinusAHalf) {
     // From one pilot, along -1: 32 samples, meant as the last round. It misses (its own error
     // 0.016, the two combined 0.0149), and 8 to 32 samples measure the slope -0.66; the next
     // round goes along -1/2 from the 32-sample round instead: 32 * (0.016 / 0.0130)^2 = 48.2.
-    const std::vector<ProgressiveRound> pilot{{8, 1, 0.04, 0.04}};
+    const std::vector<GoalRound> pilot{{8, 1, 0.04, 0.04}};
     ASSERT_TRUE(next_round(pilot, 0.01, 65536).final);
-    std::vector<ProgressiveRound> missed = pilot;
+    std::vector<GoalRound> missed = pilot;
     missed.push_back({32, 1, 0.016, combined({0.04, 0.016})});
     EXPECT_EQ(next_round(missed, 0.01, 65536).spp, 49);
     // A pilot that is not meant as the last round is no miss: the measured slope holds, -0.71
     // from 8 to 32 samples: 32 * (wanted(0.006, 0.0281) / 0.03)^(1 / -0.71) = 310.3.
-    const std::vector<ProgressiveRound> far{{8, 1, 0.08, 0.08}};
+    const std::vector<GoalRound> far{{8, 1, 0.08, 0.08}};
     ASSERT_FALSE(next_round(far, 0.006, 65536).final);
-    const std::vector<ProgressiveRound> pilots{{8, 1, 0.08, 0.08},
-                                               {32, 1, 0.03, combined({0.08, 0.03})}};
+    const std::vector<GoalRound> pilots{{8, 1, 0.08, 0.08}, {32, 1, 0.03, combined({0.08, 0.03})}};
     EXPECT_EQ(next_round(pilots, 0.006, 65536).spp, 311);
 }
 
@@ -204,14 +211,14 @@ TEST(PredictedSeconds, ALineThroughTheLastTwoRoundsOrProportionalToOne) {
 TEST(PredictedSeconds, CountsTheCameraSamplesTracedPerPixelCalibrationIncluded) {
     // A pilot of 8 spp in one pixel of 16 that rendered all its pixels twice: 1 sample per pixel
     // of the image in 1 s. Before a full round, a full round's calibration is not known.
-    const ProgressiveRound pilot{8, 1.0, {}, {}, 4, 1.0};
+    const GoalRound pilot{8, 1.0, {}, {}, RoundKind::kPilot, 4, 1.0};
     EXPECT_DOUBLE_EQ(predicted_seconds({pilot}, 10), 10.0);
     // Its set-up (before and after its tiles) is paid once, not per sample.
-    const ProgressiveRound set_up{8, 1.0, {}, {}, 4, 1.0, 0.2};
+    const GoalRound set_up{8, 1.0, {}, {}, RoundKind::kPilot, 4, 1.0, 0.2};
     EXPECT_DOUBLE_EQ(predicted_seconds({set_up}, 10), 0.2 + 0.8 * 10);
     // A full round of 10 spp with a tenth more for its calibration, 11 samples a pixel in 3 s:
     // the line through both, 0.2 s a sample after 0.8 s, and that calibration share.
-    const ProgressiveRound full{10, 3.0, {}, {}, 1, 0.1};
+    const GoalRound full{10, 3.0, {}, {}, RoundKind::kFull, 1, 0.1};
     EXPECT_DOUBLE_EQ(predicted_seconds({pilot, full}, 20), 0.8 + 0.2 * 20 * 1.1);
 }
 
@@ -296,27 +303,30 @@ TEST_F(GoalCli, SppIsTheMaximumOfAllRoundsTogether) {
         << bytes("s.json");
 }
 
-TEST(RenderProgressively, TheImageIsTheRoundsWeightedByTheirInverseEstimatedVariance) {
+TEST(RenderToGoal, TheImageIsTheRoundsWeightedByTheirInverseEstimatedVariance) {
     LoadedScene loaded = load_scene_from_string(kScene, "scene.xml");
     Scene& scene = loaded.scene;
-    ProgressiveGoal goal;
+    RenderGoal goal;
     goal.target_error = 1e-9;
     goal.max_samples = 40;
     RenderJobOptions options;
     options.threads = 2;
-    const ProgressiveResult p = render_progressively(scene, options, goal);
+    const RenderSettings before = scene.settings;
+    const GoalResult p = render_to_goal(scene, options, goal);
+    // The rounds are requests: the scene's own settings are never touched.
+    EXPECT_EQ(scene.settings.samples, before.samples);
+    EXPECT_EQ(scene.settings.seed, before.seed);
     ASSERT_EQ(p.rounds.size(), 2u);
     EXPECT_EQ(p.rounds[0].spp, 8);
     EXPECT_EQ(p.rounds[1].spp, 32);
     EXPECT_EQ(p.samples, 40);
     EXPECT_TRUE(p.combined);
-    EXPECT_EQ(scene.settings.seed, 3u);  // restored
     // Each round alone: the plain render of its count and seed.
     std::vector<RenderResult> alone;
     for (std::size_t i = 0; i < 2; ++i) {
-        scene.settings.samples = p.rounds[i].spp;
-        scene.settings.seed = round_seed(3, i);
-        alone.push_back(run_render_job(scene, options).render);
+        EXPECT_EQ(p.rounds[i].seed, round_seed(3, i));
+        alone.push_back(
+            run_render_job(scene, alone_at(p.rounds[i].spp, p.rounds[i].seed), options).render);
         ASSERT_TRUE(alone.back().stats.error.rmse);
         EXPECT_EQ(p.rounds[i].error, alone.back().stats.error.rmse);
     }
@@ -379,7 +389,7 @@ TEST(PlanTopUp, TakesPixelsByTheirNeighboursVarianceNotTheirOwn) {
     EXPECT_EQ(plan->spp, 2);
     ASSERT_EQ(plan->pixels.size(), 74u);
     EXPECT_TRUE(std::is_sorted(plan->pixels.begin(), plan->pixels.end()));
-    EXPECT_TRUE(plan->calibration.empty());  // none asked for
+    EXPECT_TRUE(plan->spot_checks.empty());  // none asked for
     const auto has = [&](int pixel) {
         return std::binary_search(plan->pixels.begin(), plan->pixels.end(),
                                   static_cast<std::uint32_t>(pixel));
@@ -441,40 +451,40 @@ TEST(PlanTopUp, CalibratesTheOtherPixelsAtRandomMostOftenNextToTheirVariance) {
     const double goal = goal_short_by(v, 1e-3);
     const auto plan = plan_top_up(v, times(v, 0.5), 8, goal, 7);
     ASSERT_TRUE(plan);
-    ASSERT_EQ(plan->calibration.size(), plan->calibration_odds.size());
-    EXPECT_TRUE(std::is_sorted(plan->calibration.begin(), plan->calibration.end()));
+    ASSERT_EQ(plan->spot_checks.size(), plan->spot_check_odds.size());
+    EXPECT_TRUE(std::is_sorted(plan->spot_checks.begin(), plan->spot_checks.end()));
     std::vector<std::uint32_t> both;
-    std::set_intersection(plan->pixels.begin(), plan->pixels.end(), plan->calibration.begin(),
-                          plan->calibration.end(), std::back_inserter(both));
+    std::set_intersection(plan->pixels.begin(), plan->pixels.end(), plan->spot_checks.begin(),
+                          plan->spot_checks.end(), std::back_inserter(both));
     EXPECT_TRUE(both.empty());
     // About 64 (the odds sum to 64 over the others): a binomial's 5 sigma either way.
-    EXPECT_GT(plan->calibration.size(), 25u);
-    EXPECT_LT(plan->calibration.size(), 105u);
+    EXPECT_GT(plan->spot_checks.size(), 25u);
+    EXPECT_LT(plan->spot_checks.size(), 105u);
     double left = 0, right = 0;
-    for (std::size_t i = 0; i < plan->calibration.size(); ++i) {
-        EXPECT_GT(plan->calibration_odds[i], 0);
-        EXPECT_LE(plan->calibration_odds[i], 1);
-        (plan->calibration[i] % 32 < 16 ? left : right) += 1;
+    for (std::size_t i = 0; i < plan->spot_checks.size(); ++i) {
+        EXPECT_GT(plan->spot_check_odds[i], 0);
+        EXPECT_LE(plan->spot_check_odds[i], 1);
+        (plan->spot_checks[i] % 32 < 16 ? left : right) += 1;
     }
     EXPECT_GT(right, left);
     // The same seed picks the same pixels; another, others.
-    EXPECT_EQ(plan_top_up(v, times(v, 0.5), 8, goal, 7)->calibration, plan->calibration);
-    EXPECT_NE(plan_top_up(v, times(v, 0.5), 8, goal, 8)->calibration, plan->calibration);
+    EXPECT_EQ(plan_top_up(v, times(v, 0.5), 8, goal, 7)->spot_checks, plan->spot_checks);
+    EXPECT_NE(plan_top_up(v, times(v, 0.5), 8, goal, 8)->spot_checks, plan->spot_checks);
     EXPECT_DOUBLE_EQ(plan->cost(1024),
-                     2.0 * 8 * double(plan->pixels.size() + plan->calibration.size()) / 1024);
+                     2.0 * 8 * double(plan->pixels.size() + plan->spot_checks.size()) / 1024);
 }
 
-TEST(RenderProgressively, ATopUpIsWeightedByTheRatioOfTheMeanVariancesOverItsPixels) {
+TEST(RenderToGoal, ATopUpIsWeightedByTheRatioOfTheMeanVariancesOverItsPixels) {
     LoadedScene loaded = load_scene_from_string(kScene, "scene.xml");
     Scene& scene = loaded.scene;
     scene.settings.width = 32;
     scene.settings.height = 24;
-    ProgressiveGoal goal;
+    RenderGoal goal;
     goal.target_error = 0.005;
     goal.max_samples = 1000;
     RenderJobOptions options;
     options.threads = 2;
-    const ProgressiveResult p = render_progressively(scene, options, goal);
+    const GoalResult p = render_to_goal(scene, options, goal);
     // As GoalCli.TargetErrorGivesTheSameBitsForAnyThreadCount: 8, 15, then 2 x 15 on some pixels.
     ASSERT_EQ(p.rounds.size(), 3u);
     ASSERT_TRUE(p.rounds[2].top_up());
@@ -482,9 +492,8 @@ TEST(RenderProgressively, ATopUpIsWeightedByTheRatioOfTheMeanVariancesOverItsPix
     // The two full rounds combined, as the image before the top-up.
     std::vector<RenderResult> alone;
     for (std::size_t i = 0; i < 2; ++i) {
-        scene.settings.samples = p.rounds[i].spp;
-        scene.settings.seed = round_seed(3, i);
-        alone.push_back(run_render_job(scene, options).render);
+        alone.push_back(
+            run_render_job(scene, alone_at(p.rounds[i].spp, round_seed(3, i)), options).render);
     }
     const double w0 = round_weight(alone[0].stats.error.rmse, 8);
     const double w1 = round_weight(alone[1].stats.error.rmse, 15);
@@ -508,30 +517,32 @@ TEST(RenderProgressively, ATopUpIsWeightedByTheRatioOfTheMeanVariancesOverItsPix
     const auto plan = plan_top_up(before, pair, 15, 0.98 * 0.005, round_seed(3, 2));
     ASSERT_TRUE(plan);
     EXPECT_EQ(plan->spp, p.rounds[2].spp);
-    EXPECT_FALSE(plan->calibration.empty());
+    EXPECT_FALSE(plan->spot_checks.empty());
     EXPECT_DOUBLE_EQ(p.rounds[2].top_up_share,
-                     double(plan->pixels.size() + plan->calibration.size()) / (32 * 24));
+                     double(plan->pixels.size() + plan->spot_checks.size()) / (32 * 24));
     // The top-up alone: its pixels, each the mean of two renders, its spread their variance.
     std::vector<std::uint32_t> all = plan->pixels;
-    all.insert(all.end(), plan->calibration.begin(), plan->calibration.end());
+    all.insert(all.end(), plan->spot_checks.begin(), plan->spot_checks.end());
     std::sort(all.begin(), all.end());
-    options.top_up = all;
-    scene.settings.samples = plan->spp;
-    scene.settings.seed = round_seed(3, 2);
-    const RenderResult t = run_render_job(scene, options).render;
+    RenderRequest top_up = alone_at(plan->spp, round_seed(3, 2));
+    top_up.pixels = PixelChoice::kListed;
+    top_up.listed = all;
+    top_up.paired = true;
+    EXPECT_EQ(p.rounds[2].seed, top_up.seed);
+    const RenderResult t = run_render_job(scene, top_up, options).render;
     ASSERT_TRUE(t.stats.error.available());
     EXPECT_EQ(p.rounds[2].error, t.stats.error.rmse);
     std::vector<int> set(n / 3, 0);  // 1: topped up, 2: calibrating
     for (const std::uint32_t pixel : plan->pixels) set[pixel] = 1;
-    for (const std::uint32_t pixel : plan->calibration) set[pixel] = 2;
+    for (const std::uint32_t pixel : plan->spot_checks) set[pixel] = 2;
     // The rounds' estimate recalibrated by what the pairs measure against the last round's
     // estimate: on the top-up's pixels, and (from the calibrating ones, by 1 / their odds)
     // everywhere else.
     double pairs[3] = {}, estimated[3] = {};
-    for (std::size_t i = 0; i < plan->calibration.size(); ++i) {
-        for (std::size_t c = 3 * plan->calibration[i]; c < 3 * plan->calibration[i] + 3; ++c) {
-            pairs[2] += 2 * double(t.spread.rgb[c]) / plan->calibration_odds[i];
-            estimated[2] += last[c] / plan->calibration_odds[i];
+    for (std::size_t i = 0; i < plan->spot_checks.size(); ++i) {
+        for (std::size_t c = 3 * plan->spot_checks[i]; c < 3 * plan->spot_checks[i] + 3; ++c) {
+            pairs[2] += 2 * double(t.spread.rgb[c]) / plan->spot_check_odds[i];
+            estimated[2] += last[c] / plan->spot_check_odds[i];
         }
     }
     for (std::size_t i = 0; i < n; ++i) {
@@ -714,10 +725,10 @@ TEST(PilotBlock, TheLargestSquareWithEnoughPilotPixelsUpToTwelve) {
 
 TEST(Predict, AfterAPilotOfSomePixelsAimsAt95PercentAlongMinusFourFifthsUp) {
     // No image yet: the round alone must reach 0.95 E, from the pilot's error.
-    const ProgressiveRound pilot{8, 0.5, 0.02, std::nullopt, 4};
+    const GoalRound pilot{8, 0.5, 0.02, std::nullopt, RoundKind::kPilot, 4};
     EXPECT_EQ(predict({pilot}, 0.01, 65536)->spp,
               static_cast<int>(std::ceil(8 * std::pow(0.0095 / 0.02, -1 / 0.8))));  // 21
-    const ProgressiveRound low{8, 0.5, 0.005, std::nullopt, 4};
+    const GoalRound low{8, 0.5, 0.005, std::nullopt, RoundKind::kPilot, 4};
     // Toward fewer samples along -3/4, as every smaller round: 8 x (0.0095 / 0.005)^(-4/3) = 3.4.
     EXPECT_EQ(predict({low}, 0.01, 65536)->spp,
               static_cast<int>(std::ceil(8 * std::pow(0.0095 / 0.005, -1 / 0.75))));
@@ -734,22 +745,21 @@ LoadedScene pilot_scene() {
     return loaded;
 }
 
-TEST(RenderProgressively, APilotOfSomePixelsMeasuresTheImageAndIsNotKept) {
+TEST(RenderToGoal, APilotOfSomePixelsMeasuresTheImageAndIsNotKept) {
     LoadedScene loaded = pilot_scene();
     Scene& scene = loaded.scene;
     ASSERT_EQ(pilot_block(128, 128), 4);
     RenderJobOptions options;
     options.threads = 2;
-    scene.settings.samples = 8;
-    const RenderResult eight = run_render_job(scene, options).render;
+    const RenderResult eight = run_render_job(scene, alone_at(8, 3), options).render;
     ASSERT_TRUE(eight.stats.error.rmse);
     // A target three times the error of 8 spp: one full round of a few samples meets it.
-    ProgressiveGoal goal;
+    RenderGoal goal;
     goal.target_error = 3 * *eight.stats.error.rmse;
     goal.max_samples = 1000;
-    const ProgressiveResult p = render_progressively(scene, options, goal);
+    const GoalResult p = render_to_goal(scene, options, goal);
     ASSERT_EQ(p.rounds.size(), 2u);
-    const ProgressiveRound& pilot = p.rounds[0];
+    const GoalRound& pilot = p.rounds[0];
     EXPECT_EQ(pilot.spp, 8);
     EXPECT_EQ(pilot.pixel_block, 4);
     EXPECT_FALSE(pilot.full());
@@ -762,17 +772,16 @@ TEST(RenderProgressively, APilotOfSomePixelsMeasuresTheImageAndIsNotKept) {
     EXPECT_LT(*pilot.error, 2.0 * *eight.stats.error.rmse);
     // Its cost: 8 samples in one pixel of 16, each of its 1,024 pixels rendered twice for its
     // estimate.
-    EXPECT_DOUBLE_EQ(pilot.calibration, 1.0);
+    EXPECT_DOUBLE_EQ(pilot.estimate_cost, 1.0);
     EXPECT_DOUBLE_EQ(pilot.cost(), 1.0);
     // The one full round is the plain render of its count and the scene's seed, bit for bit;
     // the image's samples are its own.
-    const ProgressiveRound& full = p.rounds[1];
+    const GoalRound& full = p.rounds[1];
     EXPECT_TRUE(full.full());
     EXPECT_LT(full.spp, 8);
     EXPECT_TRUE(p.target_met);
     EXPECT_EQ(p.samples, full.spp);
-    scene.settings.samples = full.spp;
-    const RenderResult plain = run_render_job(scene, options).render;
+    const RenderResult plain = run_render_job(scene, alone_at(full.spp, 3), options).render;
     EXPECT_EQ(p.job.render.image.rgb, plain.image.rgb);
     // Its estimate, recomputed as the rounds' combination, agrees to rounding.
     ASSERT_TRUE(p.error && plain.stats.error.rmse);

@@ -1,0 +1,121 @@
+// A triangle mesh as drt stores and intersects it: vertex positions in single precision relative
+// to the mesh's own origin (the centre of its bounds), one index buffer, vertex normals for
+// smooth shading, and a tree of its own over its triangles (mesh_tree.h, mesh_traversal.cpp). A
+// scene places the mesh by translating that origin (and moves it by moving the translation), so a
+// mesh keeps its single-precision detail however far from the world's origin it stands.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <type_traits>
+#include <vector>
+
+#include "drt/accel/float3.h"
+#include "drt/accel/mesh_tree.h"
+#include "drt/geometry/mesh_transform.h"
+#include "drt/geometry/triangle.h"
+#include "drt/io/obj_reader.h"
+#include "drt/util/math.h"
+#include "drt/util/ray.h"
+
+namespace drt {
+
+struct MeshHit {
+    double t;
+    std::uint32_t triangle;
+    Barycentrics b;
+};
+
+class TriangleMesh {
+  public:
+    // Transforms the file's vertices and builds the hierarchy. Triangles of zero area in the
+    // file's own coordinates are left out (dropped() counts them), and so are those that
+    // single precision flattens (collapsed() counts them). With `smooth`, vertex normals are the
+    // file's `vn` where a corner has one, else the angle-weighted normals of the faces around the
+    // vertex. Throws std::domain_error if a transformed coordinate does not fit in single
+    // precision. The hierarchy is built on `build_threads` threads (0: one per core); the tree is
+    // the same whatever their number.
+    TriangleMesh(const ObjMesh& obj, const MeshTransform& transform, bool smooth,
+                 int build_threads = 0);
+    // The same, emptying `obj` before the hierarchy is built, which lowers the peak memory.
+    TriangleMesh(ObjMesh&& obj, const MeshTransform& transform, bool smooth, int build_threads = 0);
+
+    std::size_t triangle_count() const { return triangles_.size(); }
+    std::size_t dropped() const { return dropped_; }
+    // Triangles of non-zero area whose corners, in single precision, lie on a line: no ray
+    // meets them at a well-defined point and they have no normal to shade with.
+    std::size_t collapsed() const { return collapsed_; }
+    // Where the mesh's own coordinates have their origin, in the coordinates of the transform.
+    const Vec3& origin() const { return origin_; }
+    // Bounds in the mesh's own coordinates.
+    Bounds bounds() const { return tree_.bounds(); }
+
+    // Nearest hit inside `range` of a ray given in the mesh's own coordinates.
+    std::optional<MeshHit> intersect(const Ray& ray, Interval range) const;
+    // Whether any triangle meets the ray inside `range` (stops at the first).
+    bool occluded(const Ray& ray, Interval range) const;
+    // How many triangles the query (nearest hit, or any hit) tests on its way, counting every
+    // triangle of a batch of up to four tested together: what the hierarchy saves, for tests
+    // and benchmarks.
+    std::uint64_t triangle_tests(const Ray& ray, Interval range, bool any_hit) const;
+
+    std::array<Vec3, 3> corners(std::uint32_t triangle) const {
+        const auto& t = triangles_[triangle];
+        return {position(t[0]), position(t[1]), position(t[2])};
+    }
+    // Unit (p1 - p0) × (p2 - p0): outward for a closed mesh wound counter-clockwise.
+    Vec3 geometric_normal(std::uint32_t triangle) const;
+    // Unit interpolated vertex normal, or the geometric normal for a flat mesh; may face either
+    // way relative to the geometric normal.
+    Vec3 shading_normal(std::uint32_t triangle, const Barycentrics& b) const;
+    bool smooth() const { return !normals_.empty(); }
+    // For a smooth mesh, the point at `b` moved out onto the curved surface that the vertex
+    // normals describe (SurfaceHit::light_point in object.h).
+    Vec3 lifted(std::uint32_t triangle, const Barycentrics& b) const;
+
+    // Memory held for geometry and hierarchy.
+    std::size_t bytes() const;
+
+    // The geometry as stored, for handing the same triangles to another kernel (bench/): the
+    // positions relative to origin(), and each triangle's vertices, in the order whose index
+    // MeshHit::triangle gives.
+    std::span<const Float3> positions() const { return positions_; }
+    std::span<const std::array<std::uint32_t, 3>> triangles() const { return triangles_; }
+    // The hierarchy's nodes as bytes, for telling whether two builds made the same tree.
+    std::span<const std::byte> hierarchy() const { return tree_.bytes(); }
+
+  private:
+    // The vertices, triangles and normals of the mesh from the file's.
+    void take(const ObjMesh& obj, const MeshTransform& transform, bool smooth);
+    Vec3 position(std::uint32_t vertex) const { return to_vec3(positions_[vertex]); }
+    // `threads` 0: one per core.
+    void build_hierarchy(int threads);
+    // Numbers the vertices in the order the leaves first use them, so that a leaf's corners
+    // are near each other in memory.
+    void order_vertices_by_leaves();
+    // What a query answers: whether any triangle is hit, or the nearest hit.
+    template <bool kAnyHit>
+    using Answer = std::conditional_t<kAnyHit, bool, std::optional<MeshHit>>;
+    // The query (mesh_traversal.cpp); `tests`, when given, counts the triangles tested.
+    template <bool kAnyHit>
+    Answer<kAnyHit> traverse(const Ray& ray, Interval range, std::uint64_t* tests = nullptr) const;
+
+    Vec3 origin_;
+    std::vector<Float3> positions_;  // relative to origin_
+    std::vector<Float3> normals_;    // per vertex, unit; empty for a flat mesh
+    std::vector<std::array<std::uint32_t, 3>> triangles_;  // in leaf order
+    MeshTree tree_;
+    std::size_t dropped_ = 0;
+    std::size_t collapsed_ = 0;
+};
+
+// The ray moved into a mesh's own coordinates, whose origin is at `origin`: the BVH and
+// Mesh::intersect both use it, so that they find the same hit.
+inline Ray ray_in_mesh(const Ray& ray, const Vec3& origin) {
+    return {ray.origin - origin, ray.dir, ray.time};
+}
+
+}  // namespace drt
