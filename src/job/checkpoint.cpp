@@ -32,6 +32,7 @@ constexpr char kFormatWithoutDiffuse = '4', kFormatWithDiffuse = '5';
 char format_of(DiffuseCount diffuse) {
     return diffuse == DiffuseCount::kCarried ? kFormatWithDiffuse : kFormatWithoutDiffuse;
 }
+
 // The longest version string a reader accepts, so a damaged length cannot ask for gigabytes.
 constexpr std::uint32_t kMaxVersionLength = 256;
 // Likewise for a file's name (PATH_MAX on Linux).
