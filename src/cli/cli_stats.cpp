@@ -73,6 +73,9 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
     const RayCounts& rays = r.stats.rays;
     const Effects& e = r.plan.effects;
     const RenderSettings& s = scene.settings;
+    // The path integrator's keys appear only in its renders: a distributed render's JSON is as it
+    // was before that integrator existed.
+    const bool path = s.integrator == IntegratorKind::kPath;
     std::ostringstream j;
     j << std::setprecision(6);
     j << "{\n  \"scene\": " << json_string(scene.path) << ",\n"
@@ -92,8 +95,9 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
           << ", \"assemble\": " << json_number(r.stats.assemble_seconds / n * 1e6) << "},\n";
     }
     j << "  \"rays\": {\"camera\": " << rays.camera << ", \"shadow\": " << rays.shadow
-      << ", \"reflection\": " << rays.reflection << ", \"refraction\": " << rays.refraction
-      << ", \"total\": " << rays.total() << "},\n"
+      << ", \"reflection\": " << rays.reflection << ", \"refraction\": " << rays.refraction;
+    if (path) j << ", \"diffuse\": " << rays.diffuse;
+    j << ", \"total\": " << rays.total() << "},\n"
       << "  \"million_rays_per_second\": "
       << json_number(r.stats.seconds > 0 ? rays.total() / r.stats.seconds / 1e6 : 0.0) << ",\n"
       << "  \"mean_spp\": " << json_number(double(r.stats.samples) / (double(s.width) * s.height))
@@ -118,7 +122,9 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
       << ", \"glossy_reflection\": " << json_bool(e.glossy_reflection)
       << ", \"glossy_refraction\": " << json_bool(e.glossy_refraction)
       << ", \"depth_of_field\": " << json_bool(e.depth_of_field)
-      << ", \"motion_blur\": " << json_bool(e.motion_blur) << "}\n}";
+      << ", \"motion_blur\": " << json_bool(e.motion_blur);
+    if (path) j << ", \"indirect_light\": " << json_bool(e.indirect_light);
+    j << "}\n}";
     return j.str();
 }
 

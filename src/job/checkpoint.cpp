@@ -23,8 +23,16 @@ namespace {
 using Bytes = std::vector<unsigned char>;
 
 // "DRTCKPT" and a format number, raised whenever the layout changes (the tile codec's included):
-// a reader refuses a format it does not know instead of guessing.
+// a reader refuses a format it does not know instead of guessing. Format 5 is format 4 with each
+// tile's diffuse ray count (DiffuseCount::kCarried): a path render's; a distributed render writes
+// format 4.
 constexpr char kMagic[8] = {'D', 'R', 'T', 'C', 'K', 'P', 'T', '4'};
+constexpr char kFormatWithoutDiffuse = '4', kFormatWithDiffuse = '5';
+
+char format_of(DiffuseCount diffuse) {
+    return diffuse == DiffuseCount::kCarried ? kFormatWithDiffuse : kFormatWithoutDiffuse;
+}
+
 // The longest version string a reader accepts, so a damaged length cannot ask for gigabytes.
 constexpr std::uint32_t kMaxVersionLength = 256;
 // Likewise for a file's name (PATH_MAX on Linux).
@@ -60,10 +68,10 @@ class Reader {
         return s;
     }
     // A tile of `grid`, not one of those marked in `seen`, which it then marks.
-    TileBuffer tile(std::span<const Tile> grid, std::vector<bool>& seen) {
+    TileBuffer tile(std::span<const Tile> grid, std::vector<bool>& seen, DiffuseCount diffuse) {
         std::span<const unsigned char> rest = bytes_.subspan(pos_);
         try {
-            TileBuffer t = take_tile(rest, grid, seen);
+            TileBuffer t = take_tile(rest, grid, seen, diffuse);
             pos_ = bytes_.size() - rest.size();
             return t;
         } catch (const TileCodecError& e) {
@@ -179,12 +187,14 @@ RenderIdentity identify_render(std::span<const fs::path> files, const RenderSett
     id.width = settings.width;
     id.height = settings.height;
     id.tiles = tiles;
+    id.diffuse = diffuse_count_for(settings);
     return id;
 }
 
 std::vector<unsigned char> encode_checkpoint(const RenderIdentity& id,
                                              std::span<const TileBuffer> tiles) {
     Writer w{Bytes(std::begin(kMagic), std::end(kMagic))};
+    w.bytes.back() = static_cast<unsigned char>(format_of(id.diffuse));
     w.text(id.version);
     w.u64(id.files.size());
     for (const FileFingerprint& f : id.files) {
@@ -196,20 +206,20 @@ std::vector<unsigned char> encode_checkpoint(const RenderIdentity& id,
     w.u32(static_cast<std::uint32_t>(id.height));
     w.u64(id.tiles);
     w.u64(tiles.size());
-    for (const TileBuffer& t : tiles) append_tile(w.bytes, t);
+    for (const TileBuffer& t : tiles) append_tile(w.bytes, t, id.diffuse);
     w.u64(hash_bytes(w.bytes));
     return std::move(w.bytes);
 }
 
 Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<const Tile> grid,
-                             const fs::path& file) {
+                             const fs::path& file, DiffuseCount expected) {
     if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic - 1) != 0) {
         fail(file, "not a drt checkpoint");
     }
-    if (bytes[sizeof kMagic - 1] != static_cast<unsigned char>(kMagic[sizeof kMagic - 1])) {
-        fail(file, std::string("checkpoint format ") + printable_format(bytes[sizeof kMagic - 1]) +
-                       " of another drt version, this one reads format " +
-                       kMagic[sizeof kMagic - 1] +
+    const unsigned char format = bytes[sizeof kMagic - 1];
+    if (format != kFormatWithoutDiffuse && format != kFormatWithDiffuse) {
+        fail(file, std::string("checkpoint format ") + printable_format(format) +
+                       " of another drt version, this one reads format " + format_of(expected) +
                        ": not resumed and nothing written (delete it or name another "
                        "--checkpoint file)");
     }
@@ -222,6 +232,7 @@ Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<con
     Reader r(body.subspan(sizeof kMagic), file);
     Checkpoint c;
     RenderIdentity& id = c.identity;
+    id.diffuse = format == kFormatWithDiffuse ? DiffuseCount::kCarried : DiffuseCount::kOmitted;
     id.version = r.text(kMaxVersionLength);
     const std::uint64_t files = r.u64();
     // Each takes at least 12 bytes, so a damaged count soon runs out of file.
@@ -238,7 +249,7 @@ Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<con
     const std::uint64_t count = r.u64();
     if (count > grid.size()) fail(file, "damaged checkpoint (more tiles than the image has)");
     std::vector<bool> seen(grid.size(), false);
-    for (std::uint64_t i = 0; i < count; ++i) c.tiles.push_back(r.tile(grid, seen));
+    for (std::uint64_t i = 0; i < count; ++i) c.tiles.push_back(r.tile(grid, seen, id.diffuse));
     if (r.left() != 0) fail(file, "damaged checkpoint (bytes after the last tile)");
     return c;
 }
@@ -250,13 +261,15 @@ std::optional<Checkpoint> read_checkpoint(const fs::path& file, const RenderIden
     if (status.type() == fs::file_type::not_found) return std::nullopt;
     if (ec) fail(file, "cannot examine file: " + ec.message());
     if (status.type() != fs::file_type::regular) fail(file, "not a regular file");
-    Checkpoint c = decode_checkpoint(read_all(file), grid, file);
+    Checkpoint c = decode_checkpoint(read_all(file), grid, file, expected.diffuse);
     const RenderIdentity& got = c.identity;
     std::string differs;
     if (got.version != expected.version) {
         differs = "drt " + got.version + ", not drt " + expected.version;
     } else if (got.files != expected.files) {
         differs = files_differing(got.files, expected.files);
+    } else if (got.diffuse != expected.diffuse) {
+        differs = "the other integrator (its format counts diffuse rays differently)";
     } else if (got.width != expected.width || got.height != expected.height) {
         differs = "another image size (" + std::to_string(got.width) + "x" +
                   std::to_string(got.height) + ")";

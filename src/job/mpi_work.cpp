@@ -188,10 +188,10 @@ int receive_int(const Transport& transport, int from, int tag) {
 }
 
 // A finished tile from process `from`; a damaged message is a failure of the job's transport.
-TileBuffer received_tile(std::span<const unsigned char> bytes, std::span<const Tile> grid,
+TileBuffer received_tile(std::span<const unsigned char> bytes, const RenderContext& context,
                          int from) {
     try {
-        return decode_tile(bytes, grid);
+        return decode_tile(bytes, context.tiles(), diffuse_count_for(context.scene().settings));
     } catch (const TileCodecError& e) {
         throw std::runtime_error("MPI: a tile message from process " + std::to_string(from) + ": " +
                                  e.what());
@@ -287,7 +287,7 @@ void serve(const Transport& transport, const RenderContext& context, LeaderQueue
                 if (error) break;  // drain the others, but add nothing more
                 const Clock::time_point received = Clock::now();
                 try {
-                    sink.add(received_tile(bytes, context.tiles(), from));
+                    sink.add(received_tile(bytes, context, from));
                 } catch (...) {
                     error = std::current_exception();
                     queue.close();
@@ -364,10 +364,10 @@ class WorkerQueue final : public TileSource {
 // Finished tiles of another process, encoded, waiting to be sent by its communication thread.
 class Outbox final : public TileSink {
   public:
-    explicit Outbox(Doorbell& added) : added_(added) {}
+    Outbox(Doorbell& added, DiffuseCount diffuse) : added_(added), diffuse_(diffuse) {}
 
     void add(TileBuffer buffer) override {
-        std::vector<unsigned char> bytes = encode_tile(buffer);
+        std::vector<unsigned char> bytes = encode_tile(buffer, diffuse_);
         {
             const std::lock_guard lock(mutex_);
             messages_.push_back(std::move(bytes));
@@ -386,6 +386,7 @@ class Outbox final : public TileSink {
     std::mutex mutex_;
     std::deque<std::vector<unsigned char> > messages_;
     Doorbell& added_;
+    DiffuseCount diffuse_;
 };
 
 // Another process's communication thread: keeps `threads` tiles ahead of its workers, sends
@@ -529,7 +530,7 @@ MpiShare MpiJob::render_tiles(const RenderContext& context, const RenderRequest&
     run.on_progress = nullptr;
     Doorbell doorbell;
     WorkerQueue queue(context.tiles().size(), options.stop, doorbell);
-    Outbox outbox(doorbell);
+    Outbox outbox(doorbell, diffuse_count_for(context.scene().settings));
     std::atomic<bool> workers_finished{false};
     std::jthread communicator([&] {
         work_for_leader(*transport_, context, queue, outbox, run.threads, workers_finished,

@@ -2,6 +2,7 @@
 
 #include <bit>
 #include <cstdint>
+#include <stdexcept>
 
 #include "drt/util/little_endian.h"
 
@@ -61,7 +62,15 @@ class Reader {
 TileCodecError::TileCodecError(Problem problem)
     : std::runtime_error(wording(problem)), problem_(problem) {}
 
-void append_tile(std::vector<unsigned char>& bytes, const TileBuffer& t) {
+DiffuseCount diffuse_count_for(const RenderSettings& settings) {
+    return settings.integrator == IntegratorKind::kPath ? DiffuseCount::kCarried
+                                                        : DiffuseCount::kOmitted;
+}
+
+void append_tile(std::vector<unsigned char>& bytes, const TileBuffer& t, DiffuseCount diffuse) {
+    if (diffuse == DiffuseCount::kOmitted && t.rays.diffuse != 0) {
+        throw std::invalid_argument("a tile's diffuse rays in a layout without them");
+    }
     Writer w(bytes);
     w.u64(t.tile.index);
     for (float v : t.pixels.rgb) w.f32(v);
@@ -75,18 +84,19 @@ void append_tile(std::vector<unsigned char>& bytes, const TileBuffer& t) {
     w.u64(t.rays.shadow);
     w.u64(t.rays.reflection);
     w.u64(t.rays.refraction);
+    if (diffuse == DiffuseCount::kCarried) w.u64(t.rays.diffuse);
     w.u64(t.samples);
     w.u64(t.converged);
 }
 
-std::vector<unsigned char> encode_tile(const TileBuffer& tile) {
+std::vector<unsigned char> encode_tile(const TileBuffer& tile, DiffuseCount diffuse) {
     std::vector<unsigned char> bytes;
-    append_tile(bytes, tile);
+    append_tile(bytes, tile, diffuse);
     return bytes;
 }
 
 TileBuffer take_tile(std::span<const unsigned char>& bytes, std::span<const Tile> grid,
-                     std::vector<bool>& seen) {
+                     std::vector<bool>& seen, DiffuseCount diffuse) {
     Reader r(bytes);
     const std::uint64_t index = r.u64();
     if (index >= grid.size() || seen[index]) {
@@ -111,15 +121,17 @@ TileBuffer take_tile(std::span<const unsigned char>& bytes, std::span<const Tile
     t.rays.shadow = r.u64();
     t.rays.reflection = r.u64();
     t.rays.refraction = r.u64();
+    if (diffuse == DiffuseCount::kCarried) t.rays.diffuse = r.u64();
     t.samples = r.u64();
     t.converged = r.u64();
     bytes = r.rest();
     return t;
 }
 
-TileBuffer decode_tile(std::span<const unsigned char> bytes, std::span<const Tile> grid) {
+TileBuffer decode_tile(std::span<const unsigned char> bytes, std::span<const Tile> grid,
+                       DiffuseCount diffuse) {
     std::vector<bool> seen(grid.size(), false);
-    TileBuffer t = take_tile(bytes, grid, seen);
+    TileBuffer t = take_tile(bytes, grid, seen, diffuse);
     if (!bytes.empty()) throw TileCodecError(TileCodecError::Problem::bytes_after);
     return t;
 }

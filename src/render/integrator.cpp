@@ -119,7 +119,7 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
     Vec3 shading = outside ? surface.shading_normal : -surface.shading_normal;
     if (dot(shading, ray.dir) >= 0) shading = geometric;  // bump tilted it past the viewer
 
-    Color result;
+    Color result = m.emission;  // seen from either side
     if (m.has_diffuse()) {
         const Vec3 above = outside ? surface.light_normal : -surface.light_normal;
         const Color light = scene_.ambient + direct_light(surface.light_point, above, shading,
@@ -203,6 +203,24 @@ Color Integrator::light_ray(const Light& light, const LightSample& ls, const Vec
     return light.intensity() * cosine;
 }
 
+Color Integrator::emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point, const Vec3& origin,
+                              const Vec3& geometric, const Vec3& shading, double time,
+                              RayCounts& counts) const {
+    const auto sample = plan_.emitters.sample(emitter, point, u, time);
+    if (!sample) return {};
+    const double cosine = lit_cosine(sample->dir, shading, geometric);
+    if (cosine == 0) return {};
+    ++counts.shadow;
+    const bool point_light = plan_.emitters.is_point(emitter);
+    // An emitting surface is in the BVH: the ray stops just short of it.
+    const double reach = point_light ? sample->distance : sample->distance * kShortOfEmitter;
+    if (bvh_.occluded({origin, sample->dir, time}, {0, reach})) return {};
+    // In the units of the thesis's sum of lights, which the diffuse part multiplies by
+    // diffuse·kd: irradiance over π, estimated as radiance·cos/pdf.
+    if (point_light) return sample->radiance * cosine;
+    return sample->radiance * (cosine / (kPi * sample->pdf));
+}
+
 Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const Vec3& shading,
                                double time, const PixelSample& s, int depth,
                                RayCounts& counts) const {
@@ -255,6 +273,18 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
         }
         sum += rays == 1 ? light_sum : light_sum / rays;
     }
+    for (std::size_t i = 0; i < plan_.emitters.size(); ++i) {
+        const int rays = plan_.emitter_rays[i];
+        if (rays == 0) continue;
+        const std::uint32_t dimension = dim::light(depth, scene_.lights.size() + i);
+        Color emitter_sum;
+        for (int j = 0; j < rays; ++j) {
+            const Vec2 u = rays == 1 ? sampler_.get_2d(s, dimension)
+                                     : sampler_.get_2d_in_set(s, dimension, j, rays);
+            emitter_sum += emitter_ray(i, u, point, origin, geometric, shading, time, counts);
+        }
+        sum += rays == 1 ? emitter_sum : emitter_sum / rays;
+    }
     if (plan_.shared_rays > 0) {
         // Fewer rays than area lights: each ray picks one in proportion to power (stratified
         // over the rays), and its contribution is divided by the pick probability.
@@ -270,6 +300,12 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
             const double p = cdf[k] - lo;
             u.x =
                 std::clamp((u.x - lo) / p, 0.0, std::nextafter(1.0, 0.0));  // reuse within the pick
+            if (k >= area_lights_.size()) {
+                const std::size_t emitter = plan_.area_emitters[k - area_lights_.size()];
+                sum += emitter_ray(emitter, u, point, origin, geometric, shading, time, counts) /
+                       (p * rays);
+                continue;
+            }
             if (!plan_.effects.soft_shadows) u = kLightCentre;
             const Light& light = *area_lights_[k];
             sum += light_ray(light, light.sample(point, u), origin, geometric, shading, time,

@@ -83,16 +83,16 @@ RenderContext::RenderContext(const Scene& scene)
       bvh_(scene.objects),
       area_plan_(plan_with(scene, true)),
       centre_plan_(plan_with(scene, false)),
-      area_integrator_(scene, area_plan_, bvh_, *sampler_),
-      centre_integrator_(scene, centre_plan_, bvh_, *sampler_),
+      area_integrator_(make_integrator(scene, area_plan_, bvh_, *sampler_)),
+      centre_integrator_(make_integrator(scene, centre_plan_, bvh_, *sampler_)),
       tiles_(tile_grid(scene.settings.width, scene.settings.height)) {}
 
 const RenderPlan& RenderContext::plan(const RenderRequest& request) const {
     return request.samples > 1 ? area_plan_ : centre_plan_;
 }
 
-const Integrator& RenderContext::integrator(const RenderRequest& request) const {
-    return request.samples > 1 ? area_integrator_ : centre_integrator_;
+const PixelIntegrator& RenderContext::integrator(const RenderRequest& request) const {
+    return request.samples > 1 ? *area_integrator_ : *centre_integrator_;
 }
 
 void RenderContext::check(const RenderRequest& request) const {
@@ -238,7 +238,7 @@ std::uint64_t RenderContext::tile_cost(const Tile& tile, const RenderRequest& re
     }
     // Shadow rays left out: a shading point's own work (its light sampling, textures, bump
     // maps) dwarfs what its shadow rays add.
-    const std::uint64_t shaded = rays.camera + rays.reflection + rays.refraction;
+    const std::uint64_t shaded = rays.camera + rays.reflection + rays.refraction + rays.diffuse;
     const auto pixels = static_cast<std::uint64_t>(tile.width()) * tile.height();
     return probes == 0 ? 0 : shaded * pixels / probes;
 }

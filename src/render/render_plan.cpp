@@ -43,6 +43,8 @@ RenderPlan plan_render(const Scene& scene) {
     e.depth_of_field = !scene.lens.is_pinhole();
     plan.shutter_end = scene.shutter_end();
     e.motion_blur = plan.shutter_end > 0;
+    e.indirect_light = s.integrator == IntegratorKind::kPath;
+    plan.emitters = Emitters(scene);
 
     bool diffuse_used = false;
     for (const auto& object : scene.objects) {
@@ -59,6 +61,11 @@ RenderPlan plan_render(const Scene& scene) {
     std::vector<double> area_powers;
     for (const auto& light : scene.lights) {
         if (!light->is_point()) area_powers.push_back(std::max(0.0, light->power()));
+    }
+    for (std::size_t i = 0; i < plan.emitters.size(); ++i) {
+        if (plan.emitters.is_point(i)) continue;
+        area_powers.push_back(plan.emitters[i].power);
+        plan.area_emitters.push_back(i);
     }
     e.soft_shadows = diffuse_used && !area_powers.empty();
 
@@ -81,6 +88,9 @@ RenderPlan plan_render(const Scene& scene) {
     for (const auto& light : scene.lights) {
         plan.shadow_rays.push_back(light->is_point() ? 1 : area_rays[next_area++]);
     }
+    for (std::size_t i = 0; i < plan.emitters.size(); ++i) {
+        plan.emitter_rays.push_back(plan.emitters.is_point(i) ? 1 : area_rays[next_area++]);
+    }
     return plan;
 }
 
@@ -96,8 +106,12 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
         << "max depth: " << s.max_depth << "\n"
         << "glossy rays: " << s.glossy_rays << "\n"
         << "seed: " << s.seed << "\n"
-        << "sampler: " << s.sampler << "\n"
-        << "camera: " << (scene.view ? "look-at" : "thesis pixel plane")
+        << "sampler: " << s.sampler << "\n";
+    // A distributed scene without emitting surfaces is described as before the path integrator
+    // and emitters existed.
+    const bool path = s.integrator == IntegratorKind::kPath;
+    if (path) out << "integrator: path (unbiased path tracing)\n";
+    out << "camera: " << (scene.view ? "look-at" : "thesis pixel plane")
         << (scene.lens.is_pinhole() ? ", pinhole" : ", thin lens") << "\n"
         << "materials: " << scene.materials.size() << "\n"
         << "objects: " << scene.objects.size() << " (" << moving << " moving)\n"
@@ -106,6 +120,35 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
         out << "  light " << i << ": " << (scene.lights[i]->is_point() ? "point" : "sphere")
             << ", power " << scene.lights[i]->power() << ", shadow rays per shading point "
             << plan.shadow_rays[i] << "\n";
+    }
+    std::size_t emitting_planes = 0;
+    for (const auto& object : scene.objects) {
+        const Shapes shapes = object->shapes();
+        emitting_planes += object->material().emits() ? shapes.planes.size() : 0;
+    }
+    if (path || plan.emitters.size() > 0 || emitting_planes > 0) {
+        out << "emitters: " << plan.emitters.size() << "\n";
+    }
+    for (std::size_t i = 0; i < plan.emitters.size(); ++i) {
+        const Emitters::Emitter& e = plan.emitters[i];
+        out << "  emitter " << i << ": ";
+        switch (e.kind) {
+            case Emitters::Kind::kPoint:
+                out << "point light with Falloff 1";
+                break;
+            case Emitters::Kind::kSphere:
+                out << "emitting sphere of radius " << e.radius;
+                break;
+            case Emitters::Kind::kTriangles:
+                out << "emitting triangles (" << e.mesh->triangle_count() << ")";
+                break;
+        }
+        out << ", power " << e.power << ", shadow rays per shading point " << plan.emitter_rays[i]
+            << "\n";
+    }
+    if (emitting_planes > 0) {
+        out << "  emitting planes: " << emitting_planes
+            << " (seen by rays; light found by scattered rays only)\n";
     }
     if (plan.shared_rays > 0) {
         out << "  fewer shadow rays than area lights: each of " << plan.shared_rays
@@ -122,6 +165,7 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
         << "  motion_blur: " << flag(e.motion_blur);
     if (e.motion_blur) out << " (shutter 0.." << plan.shutter_end << ")";
     out << "\n";
+    if (path) out << "  indirect_light: " << flag(e.indirect_light) << "\n";
     return out.str();
 }
 

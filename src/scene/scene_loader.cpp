@@ -137,8 +137,11 @@ class Context {
                                    std::string(element) + ": " + message));
     }
     void warn(const XMLElement& element, const std::string& message) {
-        warnings_.push_back(printable(file_ + ":" + std::to_string(element.GetLineNum()) +
-                                      ": warning: " + message));
+        warn_at(element.GetLineNum(), message);
+    }
+    void warn_at(int line, const std::string& message) {
+        warnings_.push_back(
+            printable(file_ + ":" + std::to_string(line) + ": warning: " + message));
     }
     void warn_unknown_element(const XMLElement& element, const XMLElement& parent,
                               std::span<const std::string_view> allowed) {
@@ -379,6 +382,14 @@ class SceneReader {
         scene_.path = context_.file();
         read_scene(root);
         resolve_objects();
+        add_emitting_lights();
+        if (const auto ambient = setting_lines_.find("Ambient");
+            ambient != setting_lines_.end() &&
+            scene_.settings.integrator == IntegratorKind::kPath) {
+            context_.warn_at(ambient->second,
+                             "Ambient is ignored by the path integrator, which computes the "
+                             "indirect light it stands for");
+        }
         return {std::move(scene_), context_.take_warnings(), std::move(files_read_)};
     }
 
@@ -561,6 +572,15 @@ class SceneReader {
         s.sampler = in.text("Sampler", s.sampler);
         if (!make_sampler(s.sampler))
             in.fail("unknown sampler '" + abbreviated(s.sampler) + "'; known: " + sampler_list());
+        const std::string integrator = in.text("Integrator", "distributed");
+        if (integrator == "distributed") {
+            s.integrator = IntegratorKind::kDistributed;
+        } else if (integrator == "path") {
+            s.integrator = IntegratorKind::kPath;
+        } else {
+            in.fail("unknown integrator '" + abbreviated(integrator) +
+                    "'; known: distributed, path");
+        }
         in.warn_unknown();
         warn_children(e);
     }
@@ -635,6 +655,10 @@ class SceneReader {
         m->transmit = read_transmit(in, m->transmit);
         m->kt = in.color("ktr", "ktg", "ktb", m->kt);
         m->index = in.number("index", m->index);
+        m->emission = in.color("ker", "keg", "keb", m->emission);
+        in.check(m->emission.r >= 0, "ker", "non-negative");
+        in.check(m->emission.g >= 0, "keg", "non-negative");
+        in.check(m->emission.b >= 0, "keb", "non-negative");
         in.check(m->index > 0, "index", "positive");
         if (const auto n = in.optional_number("n")) {
             in.check(*n > 0, "n", "positive");
@@ -668,9 +692,20 @@ class SceneReader {
         if (radius < 0) in.fail("negative radius " + in.shown("Radius"));
         const Color intensity = in.color("Ir", "Ig", "Ib", {1, 1, 1});
         const bool visible = in.flag("Visible", false);
+        const int falloff = in.integer("Falloff", 0);
+        in.check(falloff == 0 || falloff == 1, "Falloff", "0 or 1");
         in.warn_unknown();
         warn_children(e);
-        if (radius == 0) {
+        if (falloff == 1 && radius == 0) {
+            scene_.inverse_square_lights.push_back({position, intensity});
+        } else if (falloff == 1) {
+            // A uniform emitter of radiance I/R², which far away lights a surface as the point
+            // light of intensity I does. Built once the scene's own objects are.
+            auto material = std::make_unique<Material>();
+            material->name = "(Falloff 1 light on line " + std::to_string(e.GetLineNum()) + ")";
+            material->emission = intensity * (1.0 / (radius * radius));
+            emitting_lights_.push_back({position, radius, std::move(material)});
+        } else if (radius == 0) {
             if (visible)
                 context_.warn(e, "a point light (Radius 0) cannot be visible; Visible ignored");
             scene_.lights.push_back(std::make_unique<PointLight>(position, intensity));
@@ -847,6 +882,16 @@ class SceneReader {
         }
     }
 
+    // Falloff-1 sphere lights as emitting spheres, after the scene's own objects and materials so
+    // that no material name of the scene can refer to theirs.
+    void add_emitting_lights() {
+        for (EmittingLight& light : emitting_lights_) {
+            scene_.objects.push_back(std::make_unique<Sphere>(std::vector<Vec3>{light.centre},
+                                                              light.radius, *light.material));
+            scene_.materials.push_back(std::move(light.material));
+        }
+    }
+
     std::string unknown_material(const std::string& name) const {
         std::vector<std::string_view> names;
         for (const auto& m : scene_.materials) names.push_back(m->name);
@@ -861,6 +906,12 @@ class SceneReader {
     std::map<std::string, int, std::less<>> setting_lines_;
     std::map<std::string, int, std::less<>> material_lines_;
     std::vector<PendingObject> pending_;
+    struct EmittingLight {
+        Vec3 centre;
+        double radius;
+        std::unique_ptr<Material> material;
+    };
+    std::vector<EmittingLight> emitting_lights_;
     std::vector<std::filesystem::path> files_read_;
     TextureCache textures_;
 };

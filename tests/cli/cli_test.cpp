@@ -526,6 +526,30 @@ TEST_F(CliTest, StatsShowOnlyWhatASceneCallsFor) {
     EXPECT_FALSE(parse_json(r.out)["effects"]["antialiasing"].boolean());
 }
 
+// The path integrator's keys are in its renders' statistics only: a distributed render's keys
+// are those it had before that integrator existed.
+TEST_F(CliTest, DiffuseRaysAndIndirectLightOnlyInAPathRendersStats) {
+    const Outcome distributed =
+        run({"scene.xml", "-q", "--spp", "2", "--stats", "-", "-o", "a.pfm"});
+    ASSERT_EQ(distributed.status, 0) << distributed.err;
+    const Json d = parse_json(distributed.out);
+    EXPECT_FALSE(d["rays"].has("diffuse"));
+    EXPECT_FALSE(d["effects"].has("indirect_light"));
+
+    std::string path_scene = kScene;
+    path_scene.replace(path_scene.find("<Render "), 8, "<Render Integrator=\"path\" ");
+    write_bytes(file("path.xml"), path_scene);
+    const Outcome path = run({"path.xml", "-q", "--spp", "2", "--stats", "-", "-o", "b.pfm"});
+    ASSERT_EQ(path.status, 0) << path.err;
+    const Json p = parse_json(path.out);
+    const Json& rays = p["rays"];
+    EXPECT_GT(rays["diffuse"].number(), 0);
+    EXPECT_EQ(rays["total"].number(), rays["camera"].number() + rays["shadow"].number() +
+                                          rays["reflection"].number() +
+                                          rays["refraction"].number() + rays["diffuse"].number());
+    EXPECT_TRUE(p["effects"]["indirect_light"].boolean());
+}
+
 // ---- batch
 // ----------------------------------------------------------------------------------------
 

@@ -62,7 +62,7 @@ TEST(Checkpoint, TilesComeBackWithEveryBitAndCount) {
     const std::vector<Tile> grid = tile_grid(40, 28);
     const std::vector<TileBuffer> tiles{some_tile(grid[4], 0.25f), some_tile(grid[0], -1e-30f)};
     const std::vector<unsigned char> bytes = encode_checkpoint(identity_of(grid), tiles);
-    const Checkpoint c = decode_checkpoint(bytes, grid, "c");
+    const Checkpoint c = decode_checkpoint(bytes, grid, "c", DiffuseCount::kOmitted);
     EXPECT_EQ(c.identity, identity_of(grid));
     ASSERT_EQ(c.tiles.size(), 2u);
     for (std::size_t i = 0; i < 2; ++i) {
@@ -85,14 +85,16 @@ TEST(Checkpoint, EveryDamagedByteAndEveryTruncationIsRefused) {
     for (std::size_t i = 0; i < bytes.size(); i += 7) {
         std::vector<unsigned char> damaged = bytes;
         damaged[i] ^= 0x10;
-        EXPECT_THROW(decode_checkpoint(damaged, grid, "c"), CheckpointError) << "byte " << i;
+        EXPECT_THROW(decode_checkpoint(damaged, grid, "c", DiffuseCount::kOmitted), CheckpointError)
+            << "byte " << i;
         const std::vector<unsigned char> cut(bytes.begin(), bytes.begin() + i);
-        EXPECT_THROW(decode_checkpoint(cut, grid, "c"), CheckpointError) << "length " << i;
+        EXPECT_THROW(decode_checkpoint(cut, grid, "c", DiffuseCount::kOmitted), CheckpointError)
+            << "length " << i;
     }
     try {
         std::vector<unsigned char> damaged = bytes;
         damaged[bytes.size() / 2] ^= 1;
-        decode_checkpoint(damaged, grid, "ck.bin");
+        decode_checkpoint(damaged, grid, "ck.bin", DiffuseCount::kOmitted);
         FAIL();
     } catch (const CheckpointError& e) {
         EXPECT_EQ(std::string(e.what()),
@@ -106,7 +108,8 @@ TEST(Checkpoint, ARepeatedOrShortTileBehindAGoodChecksumIsRefusedInTheCheckpoint
     const std::vector<Tile> grid = tile_grid(40, 28);
     const auto message = [&](const std::vector<TileBuffer>& tiles) {
         try {
-            decode_checkpoint(encode_checkpoint(identity_of(grid), tiles), grid, "ck.bin");
+            decode_checkpoint(encode_checkpoint(identity_of(grid), tiles), grid, "ck.bin",
+                              DiffuseCount::kOmitted);
         } catch (const CheckpointError& e) {
             return std::string(e.what());
         }
@@ -201,6 +204,50 @@ TEST_F(TempDir, ACheckpointOfAnotherRenderIsRefusedSayingWhatDiffers) {
                   "name another --checkpoint file)");
 }
 
+// A distributed render writes format 4, whose tiles have no diffuse count; a path render format 5,
+// whose tiles have one. Either is read back, and a render of the other kind refuses it.
+TEST_F(TempDir, APathRendersCheckpointIsFormatFiveWithDiffuseCounts) {
+    const std::vector<Tile> grid = tile_grid(40, 28);
+    RenderIdentity distributed = identity_of(grid);
+    const std::vector<unsigned char> four =
+        encode_checkpoint(distributed, std::vector{some_tile(grid[1], 1.0f)});
+    EXPECT_EQ(four[7], '4');
+    RenderIdentity path = distributed;
+    path.diffuse = DiffuseCount::kCarried;
+    TileBuffer tile = some_tile(grid[1], 1.0f);
+    tile.rays.diffuse = 55;
+    const std::vector<unsigned char> five = encode_checkpoint(path, std::vector{tile});
+    EXPECT_EQ(five[7], '5');
+    EXPECT_EQ(five.size(), four.size() + 8);
+    const Checkpoint c = decode_checkpoint(five, grid, "c", DiffuseCount::kOmitted);
+    EXPECT_EQ(c.identity, path);
+    ASSERT_EQ(c.tiles.size(), 1u);
+    EXPECT_EQ(c.tiles[0].rays.diffuse, 55u);
+    EXPECT_EQ(c.tiles[0].rays.total(), 165u);
+    EXPECT_EQ(decode_checkpoint(four, grid, "c", DiffuseCount::kCarried).identity, distributed);
+
+    const fs::path file = dir_ / "ck.bin";
+    replace_file(file, five);
+    try {
+        read_checkpoint(file, distributed, grid);
+        ADD_FAILURE() << "a path render's checkpoint resumed a distributed render";
+    } catch (const CheckpointError& e) {
+        EXPECT_NE(std::string(e.what()).find("made by the other integrator"), std::string::npos)
+            << e.what();
+    }
+    std::vector<unsigned char> unknown = five;
+    unknown[7] = '6';
+    try {
+        decode_checkpoint(unknown, grid, "c", DiffuseCount::kCarried);
+        ADD_FAILURE() << "format 6 decoded";
+    } catch (const CheckpointError& e) {
+        EXPECT_NE(std::string(e.what()).find("checkpoint format 6 of another drt version, this "
+                                             "one reads format 5"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
 // A plain render's image and ray counts, for the resumed ones to match.
 RenderResult plain(const Scene& scene, const std::optional<AdaptiveSampling>& adaptive) {
     RenderOptions options;
@@ -244,6 +291,31 @@ TEST_F(TempDir, RendersStoppedAndResumedAtSeveralPointsGiveThePlainRendersBits) 
         EXPECT_EQ(r.render.stats.pixels_converged, reference.stats.pixels_converged);
         fs::remove(*options.checkpoint);
     }
+}
+
+TEST_F(TempDir, APathRenderStoppedAndResumedGivesThePlainRendersBitsAndDiffuseRays) {
+    const fs::path cornell = kSource / "scenes/gi/cornell-box.xml";
+    const Scene scene = small_scene(cornell);
+    const RenderResult reference = plain(scene, std::nullopt);
+    ASSERT_GT(reference.stats.rays.diffuse, 0u);
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
+    RenderJobOptions options;
+    options.threads = 1;
+    options.checkpoint = dir_ / "c.ckpt";
+    options.scene_files = {cornell};
+    options.stop_after_tiles = 2;
+    RenderJobResult r = run_render_job(scene, request, options);
+    ASSERT_FALSE(r.complete());
+    ASSERT_TRUE(fs::exists(*options.checkpoint));
+    EXPECT_EQ(read_bytes(*options.checkpoint).substr(0, 8), "DRTCKPT5");
+    options.stop_after_tiles.reset();
+    r = run_render_job(scene, request, options);
+    ASSERT_TRUE(r.complete());
+    EXPECT_EQ(r.resumed, 2u);
+    EXPECT_EQ(r.render.image.rgb, reference.image.rgb);
+    EXPECT_EQ(r.render.stats.rays.diffuse, reference.stats.rays.diffuse);
+    EXPECT_EQ(r.render.stats.rays.shadow, reference.stats.rays.shadow);
+    EXPECT_EQ(r.render.stats.rays.total(), reference.stats.rays.total());
 }
 
 // ---- the command line -------------------------------------------------------------------------

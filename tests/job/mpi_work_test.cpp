@@ -194,6 +194,23 @@ TEST_P(MpiProcessesAndThreads, AdaptiveRenderIsTheSingleProcesssBitsAndRayCounts
     EXPECT_EQ(r.out + r.err, "");  // -q: nothing from any process
 }
 
+// A path render's tile messages carry their diffuse ray counts to the leader.
+TEST_F(MpiCli, PathRenderIsTheSingleProcesssBitsAndDiffuseRays) {
+    const std::string cornell = (kSource / "scenes/gi/cornell-box.xml").string();
+    const std::vector<std::string> options{"--spp", "4", "-q"};
+    std::vector<std::string> plain = small(cornell, "plain.pfm", options);
+    plain.insert(plain.end(), {"--stats", "plain.json"});
+    ASSERT_EQ(run(plain).status, 0);
+    std::vector<std::string> args = small(cornell, "mpi.pfm", options);
+    args.insert(args.end(), {"--threads", "1", "--stats", "mpi.json"});
+    const Outcome r = run_mpi(3, args);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(bytes("mpi.pfm"), bytes("plain.pfm"));
+    EXPECT_EQ(rays_of(dir_ / "mpi.json"), rays_of(dir_ / "plain.json"));
+    EXPECT_NE(rays_of(dir_ / "mpi.json").find("\"diffuse\": "), std::string::npos);
+    EXPECT_EQ(rays_of(dir_ / "mpi.json").find("\"diffuse\": 0,"), std::string::npos);
+}
+
 TEST_F(MpiCli, TargetErrorGivesTheSingleProcesssBits) {
     // Every round's count and weight is decided on the leader and shared, and so are a top-up
     // round's pixels: the same rounds as one process (here 8 spp and a top-up, combined).

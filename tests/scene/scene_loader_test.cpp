@@ -1079,3 +1079,53 @@ TEST_F(SceneFile, TrianglesFlattenedBySinglePrecisionAreCountedInTheirOwnWarning
 
 }  // namespace
 }  // namespace drt
+
+namespace drt {
+namespace {
+
+// Light transport (../shared/spec/scene-format.md, "Light transport").
+TEST(SceneLoaderLightTransport, IntegratorIsDistributedUnlessPathIsNamed) {
+    EXPECT_EQ(load(in_scene("")).scene.settings.integrator, IntegratorKind::kDistributed);
+    EXPECT_EQ(load(in_scene(R"(<Render Integrator="path"/>)")).scene.settings.integrator,
+              IntegratorKind::kPath);
+    EXPECT_EQ(body_error(R"(<Render Integrator="photon"/>)"),
+              "t.xml:2: Render: unknown integrator 'photon'; known: distributed, path");
+}
+
+TEST(SceneLoaderLightTransport, EmissionIsReadAndMustNotBeNegative) {
+    const Scene scene =
+        load(in_scene(R"(<Materials><Glow ker="1" keg="2.5" keb="0"/><Gray/></Materials>)")).scene;
+    EXPECT_EQ(scene.materials[0]->emission, (Color{1, 2.5, 0}));
+    EXPECT_TRUE(scene.materials[0]->emits());
+    EXPECT_FALSE(scene.materials[1]->emits());
+    EXPECT_EQ(body_error(R"(<Materials><Glow keg="-1"/></Materials>)"),
+              "t.xml:2: Glow: keg must be non-negative, got -1");
+}
+
+TEST(SceneLoaderLightTransport, FalloffOnePointLightIsInverseSquareAndSphereLightAnEmitter) {
+    const Scene scene = load(in_scene(R"(<Light Px="1" Py="2" Pz="3" Falloff="1" Ir="4"/>
+<Light Px="0" Py="0" Pz="0" Radius="2" Falloff="1" Ir="8" Ig="8" Ib="8"/>
+<Light Px="0" Py="0" Pz="0" Radius="2"/>)"))
+                            .scene;
+    ASSERT_EQ(scene.inverse_square_lights.size(), 1u);
+    EXPECT_EQ(scene.inverse_square_lights[0].intensity, (Color{4, 1, 1}));
+    ASSERT_EQ(scene.lights.size(), 1u);  // the Falloff-0 one
+    ASSERT_EQ(scene.objects.size(), 1u);
+    EXPECT_DOUBLE_EQ(sphere(scene, 0).radius(), 2);
+    EXPECT_EQ(scene.objects[0]->material().emission, (Color{2, 2, 2}));  // I / R²
+    EXPECT_EQ(scene.objects[0]->material().diffuse, 0);
+    EXPECT_EQ(body_error(R"(<Light Px="0" Py="0" Pz="0" Falloff="2"/>)"),
+              "t.xml:2: Light: Falloff must be 0 or 1, got 2");
+}
+
+TEST(SceneLoaderLightTransport, AmbientIsIgnoredByThePathIntegratorWithAWarningNamingItsLine) {
+    const auto warnings = warnings_of(R"(<Render Integrator="path"/>
+<Ambient r="0.1"/>)");
+    ASSERT_EQ(warnings.size(), 1u);
+    EXPECT_EQ(warnings[0].rfind("t.xml:3: warning: Ambient is ignored by the path integrator", 0),
+              0u);
+    EXPECT_TRUE(warnings_of(R"(<Ambient r="0.1"/>)").empty());
+}
+
+}  // namespace
+}  // namespace drt

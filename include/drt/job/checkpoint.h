@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "drt/job/tile_codec.h"
 #include "drt/render/renderer.h"
 #include "drt/render/tile.h"
 #include "drt/scene/scene.h"
@@ -45,6 +46,8 @@ struct RenderIdentity {
     std::uint64_t options = 0;  // hash of every setting that shapes the image, the seed included
     int width = 0, height = 0;
     std::uint64_t tiles = 0;  // how many tiles the image is cut into
+    // Whether its tiles count diffuse rays: the file's format (4 without, 5 with).
+    DiffuseCount diffuse = DiffuseCount::kOmitted;
 
     friend bool operator==(const RenderIdentity&, const RenderIdentity&) = default;
 };
@@ -71,9 +74,10 @@ std::vector<unsigned char> encode_checkpoint(const RenderIdentity& identity,
                                              std::span<const TileBuffer> tiles);
 
 // Throws CheckpointError (naming `file`) for bytes that are not a whole, undamaged checkpoint
-// whose tiles lie on `grid`.
+// whose tiles lie on `grid`. Either format is read; a refusal of another format names the one a
+// render of tiles laid out as `expected` writes.
 Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<const Tile> grid,
-                             const std::filesystem::path& file);
+                             const std::filesystem::path& file, DiffuseCount expected);
 
 // The checkpoint in `file` for the render `expected` over `grid`; nothing when there is no such
 // file. Throws CheckpointError when the file cannot be read, is damaged or truncated, or was

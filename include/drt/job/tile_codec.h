@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "drt/render/tile.h"
+#include "drt/scene/scene.h"
 
 namespace drt {
 
@@ -28,16 +29,25 @@ class TileCodecError : public std::runtime_error {
     Problem problem_;
 };
 
-// Appends `tile`'s bytes to `bytes`.
-void append_tile(std::vector<unsigned char>& bytes, const TileBuffer& tile);
-std::vector<unsigned char> encode_tile(const TileBuffer& tile);
+// Whether a tile's bytes hold its count of diffuse rays. Only the path integrator traces them, so
+// only a path render's tiles carry the count and a distributed render's keep the layout without
+// it. Writer and reader agree from the scene, which every process of a render knows.
+enum class DiffuseCount { kOmitted, kCarried };
+
+// The layout of the tiles of a render with these settings.
+DiffuseCount diffuse_count_for(const RenderSettings& settings);
+
+// Appends `tile`'s bytes to `bytes`. Omitting the diffuse count requires it to be 0.
+void append_tile(std::vector<unsigned char>& bytes, const TileBuffer& tile, DiffuseCount diffuse);
+std::vector<unsigned char> encode_tile(const TileBuffer& tile, DiffuseCount diffuse);
 
 // Decodes the tile at the front of `bytes` and drops its bytes from the view. The tile must be
 // one of `grid` not yet marked in `seen` (grid.size() flags), which it then marks.
 TileBuffer take_tile(std::span<const unsigned char>& bytes, std::span<const Tile> grid,
-                     std::vector<bool>& seen);
+                     std::vector<bool>& seen, DiffuseCount diffuse);
 
 // A message of exactly one tile of `grid`.
-TileBuffer decode_tile(std::span<const unsigned char> bytes, std::span<const Tile> grid);
+TileBuffer decode_tile(std::span<const unsigned char> bytes, std::span<const Tile> grid,
+                       DiffuseCount diffuse);
 
 }  // namespace drt

@@ -10,6 +10,7 @@
 
 #include "drt/accel/bvh.h"
 #include "drt/accel/occluders.h"
+#include "drt/render/pixel_integrator.h"
 #include "drt/render/render_plan.h"
 #include "drt/sampling/sampler.h"
 #include "drt/scene/camera.h"
@@ -17,23 +18,15 @@
 
 namespace drt {
 
-// Rays actually traced, by kind.
-struct RayCounts {
-    std::uint64_t camera = 0, shadow = 0, reflection = 0, refraction = 0;
-
-    std::uint64_t total() const { return camera + shadow + reflection + refraction; }
-    RayCounts& operator+=(const RayCounts& o) {
-        camera += o.camera, shadow += o.shadow, reflection += o.reflection,
-            refraction += o.refraction;
-        return *this;
-    }
-};
-
 // Moves a ray origin off the surface it starts on, to the side `dir` leaves by, far enough that
 // rounding in the hit point cannot make the ray hit that surface again. The distance scales with
 // the point's magnitude (|p|·2⁻³² + 1e-9), a million times the double-precision rounding
 // error of a re-projected hit point, and still invisible (2.3e-5 at 1e5 from the origin).
 Ray spawn_ray(const Vec3& point, const Vec3& normal, const Vec3& dir, double time);
+
+// A shadow ray towards a point on an emitting surface (which the BVH holds) ends this fraction of
+// the way there, so that rounding cannot make the emitter block its own light.
+inline constexpr double kShortOfEmitter = 1 - 1e-6;
 
 // A direction about `ideal` whose angle from it is Rayleigh-distributed with scale sigma, i.e.
 // a 2-D normal distribution of standard deviation sigma (radians) on the tangent plane.
@@ -48,14 +41,14 @@ Vec3 reflect_above(const Vec3& d, const Vec3& shading, const Vec3& geometric);
 std::optional<Vec3> refract_below(const Vec3& d, const Vec3& shading, const Vec3& geometric,
                                   double eta);
 
-class Integrator {
+class Integrator final : public PixelIntegrator {
   public:
     Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bvh, const Sampler& sampler);
 
     // Camera samples s.index, s.index + 1, ... of pixel (x, y): the radiance along each camera
     // ray, into out. A run of a pixel's samples shares the work of drawing their camera points.
     void sample_pixel(int x, int y, const PixelSample& s, std::span<Color> out,
-                      RayCounts& counts) const;
+                      RayCounts& counts) const override;
 
     // Radiance arriving along `ray`, which is `depth` reflections/refractions from the camera.
     Color radiance(const Ray& ray, const PixelSample& s, int depth, RayCounts& counts) const;
@@ -75,6 +68,11 @@ class Integrator {
     Color light_ray(const Light& light, const LightSample& ls, const Vec3& origin,
                     const Vec3& geometric, const Vec3& shading, double time,
                     const Occluders& occluders, RayCounts& counts) const;
+    // One shadow ray towards emitter `emitter` (emitters.h) for the point u of the unit square,
+    // in the units of direct_light.
+    Color emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point, const Vec3& origin,
+                      const Vec3& geometric, const Vec3& shading, double time,
+                      RayCounts& counts) const;
     // Average radiance along `rays` directions about `ideal` (one exactly ideal ray if sigma is
     // 0), each redrawn until it leaves on the `side` of the surface (+1 = the normal's side).
     Color scattered(const Vec3& point, const Vec3& geometric, const Vec3& ideal, double sigma,

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "drt/accel/bvh.h"
-#include "drt/render/integrator.h"
+#include "drt/render/pixel_integrator.h"
 #include "drt/render/render_plan.h"
 #include "drt/render/render_request.h"
 #include "drt/render/tile.h"
@@ -81,7 +81,7 @@ class RenderContext {
         std::vector<double> luminances;
     };
 
-    const Integrator& integrator(const RenderRequest& request) const;
+    const PixelIntegrator& integrator(const RenderRequest& request) const;
     // One pixel on ray-tree path `path` (0 for the image's own render), adaptively or not; they
     // add their rays to `rays`.
     Pixel render_pixel(const RenderRequest& request, int x, int y, std::uint64_t path,
@@ -109,7 +109,8 @@ class RenderContext {
     Bvh bvh_;
     // For requests of more than one sample per pixel, and for those of one (pixel centres).
     RenderPlan area_plan_, centre_plan_;
-    Integrator area_integrator_, centre_integrator_;
+    // The integrator the scene names (make_integrator), over each plan.
+    std::unique_ptr<const PixelIntegrator> area_integrator_, centre_integrator_;
     std::vector<Tile> tiles_;
 };
 

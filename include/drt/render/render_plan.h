@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "drt/scene/emitters.h"
 #include "drt/scene/scene.h"
 
 namespace drt {
@@ -19,6 +20,7 @@ struct Effects {
     bool glossy_refraction = false;  // a transparent material with finite sharpness
     bool depth_of_field = false;     // a lens of non-zero radius
     bool motion_blur = false;        // a moving object
+    bool indirect_light = false;     // the path integrator: light scattered by diffuse surfaces
 };
 
 struct RenderPlan {
@@ -30,6 +32,12 @@ struct RenderPlan {
     std::vector<int> shadow_rays;
     int shared_rays = 0;
     std::vector<double> light_pick_cdf;  // over the area lights' powers, for shared rays
+    // The physical lights (emitters.h), which share the shadow rays with the lights as area
+    // lights do (a Falloff-1 point light gets exactly one): their rays per shading point, 0 when
+    // shared; a shared ray's pick beyond the area lights is area_emitters[pick - area lights].
+    Emitters emitters;
+    std::vector<int> emitter_rays;
+    std::vector<std::size_t> area_emitters;
     double shutter_end = 0;
 };
 

@@ -16,6 +16,10 @@
 
 namespace drt {
 
+// How light is carried: the thesis's distributed ray tracer, or unbiased path tracing
+// (../shared/spec/scene-format.md, "Light transport").
+enum class IntegratorKind { kDistributed, kPath };
+
 struct RenderSettings {
     int width = 640;
     int height = 480;
@@ -25,9 +29,17 @@ struct RenderSettings {
     int glossy_rays = 1;  // rays per glossy reflection/refraction at the first hit
     std::uint64_t seed = 0;
     std::string sampler = "stratified";
+    IntegratorKind integrator = IntegratorKind::kDistributed;
     // World units per pixel of the thesis's pixel-plane camera: 1 as the scene format defines
     // it; drt --scale changes it so a smaller or larger image keeps the same framing.
     double pixel_plane_unit = 1;
+};
+
+// A point light with Falloff 1: it adds I·max(0, N·L)/r² to the thesis's sum of lights. (A sphere
+// light with Falloff 1 becomes an emitting sphere among the objects instead.)
+struct InverseSquareLight {
+    Vec3 position;
+    Color intensity;
 };
 
 struct Scene {
@@ -41,6 +53,7 @@ struct Scene {
     std::vector<std::unique_ptr<Material>> materials;
     std::vector<std::unique_ptr<Light>> lights;
     std::vector<std::unique_ptr<Object>> objects;
+    std::vector<InverseSquareLight> inverse_square_lights;
 
     // The camera for the current settings (the default camera depends on the image size).
     Camera camera() const;

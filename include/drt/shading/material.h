@@ -21,6 +21,8 @@ struct Material {
     Color kt{1, 1, 1};
     double index = 1.5;
     std::optional<double> sharpness;  // n; absent = ideal mirror/refraction
+    // ker keg keb: radiance emitted from both sides of every surface with this material.
+    Color emission{0, 0, 0};
 
     // Below this angular spread a perturbed direction is indistinguishable from the ideal one.
     static constexpr double kIdealSigma = 1e-4;
@@ -35,6 +37,7 @@ struct Material {
     bool reflects() const { return reflective > 0 && !is_black(ks); }
     bool transmits() const { return transmit > 0 && !is_black(kt); }
     bool has_diffuse() const { return diffuse > 0; }
+    bool emits() const { return !is_black(emission); }
 };
 
 // Fraction of unpolarised light reflected at a smooth interface (exact Fresnel equations).

@@ -1,0 +1,70 @@
+// The lights that are physical: emitting surfaces (a material's ker keg keb on a sphere or a
+// triangle mesh) and Falloff-1 point lights, as next-event estimation samples them. Spheres are
+// sampled by the solid angle they subtend, a mesh by area over its triangles (one emitted
+// radiance per mesh, so area is its power distribution), a Falloff-1 point light is a point.
+// Emitting planes are infinite: they are seen by rays and found by scattered rays only.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include "drt/accel/mesh.h"
+#include "drt/geometry/motion.h"
+#include "drt/scene/scene.h"
+
+namespace drt {
+
+// A direction from a shading point towards an emitter and what arrives along it.
+struct EmitterSample {
+    Vec3 dir;         // unit
+    double distance;  // to the emitter along dir
+    Color radiance;   // emitted radiance; for a point, its intensity over distance squared
+    double pdf;       // of dir, per unit solid angle; 0 for a point (a single direction)
+};
+
+class Emitters {
+  public:
+    enum class Kind { kPoint, kSphere, kTriangles };
+    struct Emitter {
+        Kind kind = Kind::kPoint;
+        Color radiance;                    // a point's intensity I
+        const Object* object = nullptr;    // the emitting object; null for a point
+        Vec3 position;                     // a point's
+        const MotionPath* path = nullptr;  // a sphere's centre, a mesh's origin, over time
+        double radius = 0;                 // a sphere's
+        const TriangleMesh* mesh = nullptr;
+        std::vector<double> area_cdf;  // a mesh's triangles by area, the last exactly 1
+        double area = 0;               // a sphere's or mesh's whole surface
+        // What next-event estimation shares shadow rays by, in the units of a thesis light's
+        // luminance(I): luminance(I) for a point, luminance(radiance)·area/(4π) for a surface
+        // (so a Falloff-1 sphere light of intensity I has the power of a point light of I).
+        double power = 0;
+    };
+
+    // Every Falloff-1 point light, in scene order, then every emitting sphere and mesh (not
+    // plane), in object order.
+    Emitters() = default;
+    explicit Emitters(const Scene& scene);
+
+    std::size_t size() const { return emitters_.size(); }
+    const Emitter& operator[](std::size_t i) const { return emitters_[i]; }
+    bool is_point(std::size_t i) const { return emitters_[i].kind == Kind::kPoint; }
+
+    // A direction towards emitter i from x at `time`, from a uniform point u of the unit square;
+    // nothing when the sample cannot reach x (an edge-on triangle).
+    std::optional<EmitterSample> sample(std::size_t i, const Vec3& x, Vec2 u, double time) const;
+    // The density per unit solid angle with which sample(i, x, ·, time) picks the direction
+    // from x to `point` on the emitter, whose geometric normal there is `normal`.
+    double pdf(std::size_t i, const Vec3& x, const Vec3& point, const Vec3& normal,
+               double time) const;
+    // Which emitter an object is, if it is sampled as one.
+    std::optional<std::size_t> index_of(const Object* object) const;
+
+  private:
+    std::vector<Emitter> emitters_;
+    std::unordered_map<const Object*, std::size_t> by_object_;
+};
+
+}  // namespace drt

@@ -1,0 +1,327 @@
+#include "drt/render/path_integrator.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "drt/render/integrator.h"
+#include "drt/util/rng.h"
+
+namespace drt {
+
+namespace {
+
+// The path integrator's sampler dimensions: each scattering event (depth d, 0 at the camera ray's
+// hit) has its own, so a sampler stratifies every bounce on its own. They lie apart from the
+// distributed integrator's (sampler.h); a light's dimension at a depth is light(d, i).
+namespace path_dim {
+constexpr std::uint32_t kBase = 0x40000000;
+enum : std::uint32_t { kLightPick, kLobe, kScatter, kFresnel, kRoulette, kLight, kPerEvent };
+constexpr std::uint32_t at(int depth, std::uint32_t kind) {
+    return kBase + static_cast<std::uint32_t>(depth) * kPerEvent + kind;
+}
+constexpr std::uint32_t light(int depth, std::size_t index) {
+    return at(depth, kLight) + (static_cast<std::uint32_t>(index) << 16);
+}
+}  // namespace path_dim
+
+// Scattering events before Russian roulette may end a path: the first bounces carry most of the
+// light and are never cut short.
+constexpr int kRouletteStart = 3;
+
+// As in the distributed integrator: a perturbed direction on the wrong side is redrawn this often
+// before the ideal one is taken.
+constexpr int kRedrawAttempts = 32;
+
+// Veach's power heuristic (exponent 2) for a sample of density `own` against one of `other`,
+// both already multiplied by their expected sample counts; written as a ratio so that a huge
+// density (a small, distant emitter) cannot overflow.
+double power_heuristic(double own, double other) {
+    if (!(other > 0)) return 1;
+    const double r = other / own;
+    return 1 / (1 + r * r);
+}
+
+double max_component(const Color& c) {
+    return std::max({c.r, c.g, c.b});
+}
+
+// A direction about unit `n` with density cos θ / π.
+Vec3 cosine_direction(const Vec3& n, Vec2 u) {
+    const double r = std::sqrt(u.x);
+    const SinCos phi = sincos_turns(u.y);
+    const Vec3 local{r * phi.cos, r * phi.sin, std::sqrt(std::max(0.0, 1 - u.x))};
+    return normalize(Frame::around(n).to_world(local));
+}
+
+}  // namespace
+
+PathIntegrator::PathIntegrator(const Scene& scene, const RenderPlan& plan, const Bvh& bvh,
+                               const Sampler& sampler, Strategy strategy)
+    : scene_(scene),
+      plan_(plan),
+      bvh_(bvh),
+      sampler_(sampler),
+      strategy_(strategy),
+      camera_(scene.camera()) {
+    for (const auto& light : scene.lights) {
+        any_visible_light_ = any_visible_light_ || light->visible();
+        if (!light->is_point()) area_lights_.push_back(light.get());
+    }
+    emitter_rays_.assign(plan.emitters.size(), 0.0);
+    for (std::size_t i = 0; i < plan.emitters.size(); ++i) {
+        emitter_rays_[i] = plan.emitter_rays[i];
+    }
+    // Shared rays: each picks emitter k with probability P_k, so N rays sample it N·P_k times.
+    const auto& cdf = plan.light_pick_cdf;
+    for (std::size_t j = 0; plan.shared_rays > 0 && j < plan.area_emitters.size(); ++j) {
+        const std::size_t k = area_lights_.size() + j;
+        const double p = cdf[k] - (k == 0 ? 0.0 : cdf[k - 1]);
+        emitter_rays_[plan.area_emitters[j]] += plan.shared_rays * p;
+    }
+}
+
+void PathIntegrator::sample_pixel(int x, int y, const PixelSample& s, std::span<Color> out,
+                                  RayCounts& counts) const {
+    const Effects& e = plan_.effects;
+    std::vector<Vec2> film(out.size(), Vec2{x + 0.5, y + 0.5});
+    if (e.antialiasing) {
+        sampler_.get_2d_run(s, dim::kPixel, film);
+        for (Vec2& f : film) f = {x + f.x, y + f.y};
+    }
+    std::vector<Vec2> lens(out.size(), Vec2{0.5, 0.5});
+    if (e.depth_of_field) sampler_.get_2d_run(s, dim::kLens, lens);
+    PixelSample sample = s;
+    for (std::size_t i = 0; i < out.size(); ++i, ++sample.index) {
+        const double time =
+            e.motion_blur ? sampler_.get_1d(sample, dim::kTime) * plan_.shutter_end : 0.0;
+        ++counts.camera;
+        out[i] = radiance(camera_.generate_ray(film[i], lens[i], time), sample, counts);
+    }
+}
+
+Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
+                               RayCounts& counts) const {
+    const Effects& e = plan_.effects;
+    const int max_depth = scene_.settings.max_depth;
+    Color result;
+    Color throughput{1, 1, 1};
+    Ray ray = camera_ray;
+    // Whether the ray was scattered by a diffuse part: then an emitter it meets was also sampled
+    // by next-event estimation from `from`, and `scatter_density` is the density with which this
+    // direction was chosen (the part's pick probability included).
+    bool after_diffuse = false;
+    Vec3 from;
+    double scatter_density = 0;
+    for (int depth = 0;; ++depth) {
+        const auto hit = bvh_.intersect(ray, {0, kInfinity});
+        // The thesis's visible lights are seen as in the distributed integrator; light from them
+        // reaches diffuse surfaces by shadow rays alone.
+        if (any_visible_light_ && !after_diffuse) {
+            double nearest = hit ? hit->t : kInfinity;
+            const Light* seen = nullptr;
+            for (const auto& light : scene_.lights) {
+                if (!light->visible()) continue;
+                if (auto t = light->intersect(ray, {0, nearest})) nearest = *t, seen = light.get();
+            }
+            if (seen) return result + throughput * seen->intensity();
+        }
+        if (!hit) return result + throughput * scene_.background;
+
+        const Material& m = hit->object->material();
+        const SurfaceHit surface = hit->object->surface_at(ray, *hit);
+        const bool outside = dot(ray.dir, surface.normal) < 0;
+        const Vec3 geometric = outside ? surface.normal : -surface.normal;
+        Vec3 shading = outside ? surface.shading_normal : -surface.shading_normal;
+        if (dot(shading, ray.dir) >= 0) shading = geometric;
+
+        if (m.emits()) {
+            double weight = 1;
+            const auto emitter =
+                after_diffuse ? plan_.emitters.index_of(hit->object) : std::optional<std::size_t>{};
+            if (emitter && strategy_ == Strategy::kLightOnly) {
+                weight = 0;
+            } else if (emitter && strategy_ == Strategy::kMis) {
+                const double light =
+                    emitter_rays_[*emitter] *
+                    plan_.emitters.pdf(*emitter, from, surface.point, surface.normal, ray.time);
+                weight = power_heuristic(scatter_density, light);
+            }
+            result += throughput * m.emission * weight;
+        }
+        if (depth >= max_depth) return result;
+
+        // Each part is picked in proportion to its weight and then carries its own over the
+        // pick's probability.
+        const Color diffuse_colour = m.diffuse * surface.kd;
+        const double diffuse_weight =
+            m.has_diffuse() ? std::max(0.0, luminance(diffuse_colour)) : 0;
+        const double reflect_weight =
+            m.reflects() ? std::max(0.0, m.reflective * luminance(m.ks)) : 0;
+        const double transmit_weight =
+            m.transmits() ? std::max(0.0, m.transmit * luminance(m.kt)) : 0;
+        const double total = diffuse_weight + reflect_weight + transmit_weight;
+        if (!(total > 0)) return result;
+        const double diffuse_pick = diffuse_weight / total;
+
+        if (diffuse_weight > 0) {
+            const Vec3 above = outside ? surface.light_normal : -surface.light_normal;
+            result += throughput * diffuse_colour *
+                      next_event(surface.light_point, above, shading, ray.time, s, depth,
+                                 diffuse_pick, counts);
+        }
+
+        const double pick = sampler_.get_1d(s, path_dim::at(depth, path_dim::kLobe)) * total;
+        const std::uint32_t scatter_dimension = path_dim::at(depth, path_dim::kScatter);
+        Vec3 dir;
+        if (pick < diffuse_weight) {
+            dir = cosine_direction(shading, sampler_.get_2d(s, scatter_dimension));
+            const double cosine = lit_cosine(dir, shading, geometric);
+            if (cosine == 0) return result;  // below the surface: no light comes from there
+            throughput *= diffuse_colour / diffuse_pick;
+            after_diffuse = true;
+            from = surface.light_point;
+            scatter_density = diffuse_pick * cosine / kPi;
+            ++counts.diffuse;
+        } else if (pick < diffuse_weight + reflect_weight) {
+            const double sigma = e.glossy_reflection ? m.sigma() : 0.0;
+            dir = perturbed(reflect_above(ray.dir, shading, geometric), sigma, +1, geometric, s,
+                            scatter_dimension);
+            throughput *= m.reflective * m.ks / (reflect_weight / total);
+            after_diffuse = false;
+            ++counts.reflection;
+        } else {
+            const double sigma = m.sigma();
+            const double eta = outside ? 1.0 / m.index : m.index;
+            const double cos_i = std::max(0.0, -dot(ray.dir, shading));
+            const double fresnel = fresnel_dielectric(cos_i, eta);
+            // Reflected with probability F, refracted otherwise: F and 1 − F cancel.
+            throughput *= m.transmit * m.kt / (transmit_weight / total);
+            after_diffuse = false;
+            if (sampler_.get_1d(s, path_dim::at(depth, path_dim::kFresnel)) < fresnel) {
+                dir = perturbed(reflect_above(ray.dir, shading, geometric),
+                                e.glossy_reflection ? sigma : 0.0, +1, geometric, s,
+                                scatter_dimension);
+                ++counts.reflection;
+            } else {
+                const auto through = refract_below(ray.dir, shading, geometric, eta);
+                if (!through) return result;
+                dir = perturbed(*through, e.glossy_refraction ? sigma : 0.0, -1, geometric, s,
+                                scatter_dimension);
+                ++counts.refraction;
+            }
+        }
+
+        if (depth + 1 >= kRouletteStart) {
+            const double survival = std::min(1.0, max_component(throughput));
+            if (!(survival > 0)) return result;
+            if (survival < 1) {
+                if (sampler_.get_1d(s, path_dim::at(depth, path_dim::kRoulette)) >= survival) {
+                    return result;
+                }
+                throughput = throughput / survival;
+            }
+        }
+        ray = spawn_ray(surface.point, geometric, dir, ray.time);
+    }
+}
+
+Vec3 PathIntegrator::perturbed(const Vec3& ideal, double sigma, double side, const Vec3& geometric,
+                               const PixelSample& s, std::uint32_t dimension) const {
+    if (!(sigma > 0)) return ideal;
+    Vec2 u = sampler_.get_2d(s, dimension);
+    for (int attempt = 1;; ++attempt) {
+        const Vec3 dir = perturb_direction(ideal, sigma, u);
+        if (side * dot(dir, geometric) > 0) return dir;
+        if (attempt == kRedrawAttempts) return ideal;
+        const std::uint64_t h = hash_of(s.seed, s.pixel, s.index, dimension, s.path, 0, attempt);
+        u = {to_unit(h), to_unit(mix64(h))};
+    }
+}
+
+Color PathIntegrator::light_ray(const Light& light, Vec2 u, const Vec3& point, const Vec3& origin,
+                                const Vec3& geometric, const Vec3& shading, double time,
+                                RayCounts& counts) const {
+    const LightSample ls = light.sample(point, u);
+    const double cosine = lit_cosine(ls.dir, shading, geometric);
+    if (cosine == 0) return {};
+    ++counts.shadow;
+    if (bvh_.occluded({origin, ls.dir, time}, {0, ls.distance})) return {};
+    return light.intensity() * cosine;
+}
+
+Color PathIntegrator::emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point,
+                                  const Vec3& origin, const Vec3& geometric, const Vec3& shading,
+                                  double time, double diffuse_pick, RayCounts& counts) const {
+    const auto sample = plan_.emitters.sample(emitter, point, u, time);
+    if (!sample) return {};
+    const double cosine = lit_cosine(sample->dir, shading, geometric);
+    if (cosine == 0) return {};
+    ++counts.shadow;
+    const bool point_light = plan_.emitters.is_point(emitter);
+    const double reach = point_light ? sample->distance : sample->distance * kShortOfEmitter;
+    if (bvh_.occluded({origin, sample->dir, time}, {0, reach})) return {};
+    if (point_light) return sample->radiance * cosine;
+    const double weight =
+        strategy_ == Strategy::kMis
+            ? power_heuristic(emitter_rays_[emitter] * sample->pdf, diffuse_pick * cosine / kPi)
+            : 1.0;
+    return sample->radiance * (cosine * weight / (kPi * sample->pdf));
+}
+
+Color PathIntegrator::next_event(const Vec3& point, const Vec3& geometric, const Vec3& shading,
+                                 double time, const PixelSample& s, int depth, double diffuse_pick,
+                                 RayCounts& counts) const {
+    const Vec3 origin = spawn_ray(point, geometric, geometric, time).origin;
+    const bool emitters = strategy_ != Strategy::kScatterOnly;
+    const auto point_of = [&](std::uint32_t dimension, int j, int rays) {
+        return rays == 1 ? sampler_.get_2d(s, dimension)
+                         : sampler_.get_2d_in_set(s, dimension, static_cast<std::uint32_t>(j),
+                                                  static_cast<std::uint32_t>(rays));
+    };
+    Color sum;
+    for (std::size_t i = 0; i < scene_.lights.size(); ++i) {
+        const int rays = plan_.shadow_rays[i];
+        Color light_sum;
+        for (int j = 0; j < rays; ++j) {
+            light_sum += light_ray(*scene_.lights[i], point_of(path_dim::light(depth, i), j, rays),
+                                   point, origin, geometric, shading, time, counts);
+        }
+        if (rays > 0) sum += light_sum / rays;
+    }
+    for (std::size_t i = 0; emitters && i < plan_.emitters.size(); ++i) {
+        const int rays = plan_.emitter_rays[i];
+        const std::uint32_t dimension = path_dim::light(depth, scene_.lights.size() + i);
+        Color emitter_sum;
+        for (int j = 0; j < rays; ++j) {
+            emitter_sum += emitter_ray(i, point_of(dimension, j, rays), point, origin, geometric,
+                                       shading, time, diffuse_pick, counts);
+        }
+        if (rays > 0) sum += emitter_sum / rays;
+    }
+    if (plan_.shared_rays > 0) {
+        // Each ray picks a light or an emitter in proportion to power and is divided by the
+        // pick's probability, as in the distributed integrator.
+        const int rays = plan_.shared_rays;
+        const auto& cdf = plan_.light_pick_cdf;
+        for (int j = 0; j < rays; ++j) {
+            Vec2 u = point_of(path_dim::at(depth, path_dim::kLightPick), j, rays);
+            const std::size_t k = std::min<std::size_t>(
+                std::upper_bound(cdf.begin(), cdf.end(), u.x) - cdf.begin(), cdf.size() - 1);
+            const double lo = k == 0 ? 0.0 : cdf[k - 1];
+            const double p = cdf[k] - lo;
+            u.x = std::clamp((u.x - lo) / p, 0.0, std::nextafter(1.0, 0.0));
+            if (k < area_lights_.size()) {
+                sum += light_ray(*area_lights_[k], u, point, origin, geometric, shading, time,
+                                 counts) /
+                       (p * rays);
+            } else if (emitters) {
+                sum += emitter_ray(plan_.area_emitters[k - area_lights_.size()], u, point, origin,
+                                   geometric, shading, time, diffuse_pick, counts) /
+                       (p * rays);
+            }
+        }
+    }
+    return sum;
+}
+
+}  // namespace drt

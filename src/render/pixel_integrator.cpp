@@ -1,0 +1,16 @@
+#include "drt/render/pixel_integrator.h"
+
+#include "drt/render/integrator.h"
+#include "drt/render/path_integrator.h"
+
+namespace drt {
+
+std::unique_ptr<PixelIntegrator> make_integrator(const Scene& scene, const RenderPlan& plan,
+                                                 const Bvh& bvh, const Sampler& sampler) {
+    if (scene.settings.integrator == IntegratorKind::kPath) {
+        return std::make_unique<PathIntegrator>(scene, plan, bvh, sampler);
+    }
+    return std::make_unique<Integrator>(scene, plan, bvh, sampler);
+}
+
+}  // namespace drt

@@ -1,0 +1,166 @@
+#include "drt/scene/emitters.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "drt/geometry/sphere.h"
+#include "drt/scene/light.h"
+
+namespace drt {
+
+namespace {
+
+// A point this close to a sphere (relative to its radius squared) is on it: the cone it subtends
+// is then the whole half-space, which uniform directions over the sphere of directions cover.
+constexpr double kOnSphere = 1e-7;
+
+bool inside_sphere(double d2, double radius) {
+    return d2 <= radius * radius * (1 + kOnSphere);
+}
+
+// 1 − cos of the half-angle of the cone a sphere subtends from a point d² away from its centre,
+// without the cancellation of 1 − sqrt(1 − r²/d²) for a small, distant sphere.
+double one_minus_cos_max(double d2, double radius) {
+    const double sin2 = radius * radius / d2;
+    return sin2 / (1 + std::sqrt(std::max(0.0, 1 - sin2)));
+}
+
+double triangle_area(const std::array<Vec3, 3>& p) {
+    return 0.5 * length(cross(p[1] - p[0], p[2] - p[0]));
+}
+
+}  // namespace
+
+Emitters::Emitters(const Scene& scene) {
+    for (const InverseSquareLight& light : scene.inverse_square_lights) {
+        Emitter e;
+        e.kind = Kind::kPoint;
+        e.radiance = light.intensity;
+        e.position = light.position;
+        e.power = std::max(0.0, luminance(light.intensity));
+        emitters_.push_back(std::move(e));
+    }
+    for (const auto& object : scene.objects) {
+        const Material& m = object->material();
+        if (!m.emits()) continue;
+        const Shapes shapes = object->shapes();
+        for (const SphereShape& sphere : shapes.spheres) {
+            Emitter e;
+            e.kind = Kind::kSphere;
+            e.radiance = m.emission;
+            e.object = object.get();
+            e.path = sphere.path;
+            e.radius = sphere.radius;
+            e.area = 4 * kPi * sphere.radius * sphere.radius;
+            emitters_.push_back(std::move(e));
+        }
+        for (const MeshShape& shape : shapes.meshes) {
+            Emitter e;
+            e.kind = Kind::kTriangles;
+            e.radiance = m.emission;
+            e.object = object.get();
+            e.path = shape.path;
+            e.mesh = shape.mesh;
+            for (std::uint32_t t = 0; t < shape.mesh->triangle_count(); ++t) {
+                e.area += triangle_area(shape.mesh->corners(t));
+                e.area_cdf.push_back(e.area);
+            }
+            if (!(e.area > 0)) continue;
+            for (double& c : e.area_cdf) c /= e.area;
+            e.area_cdf.back() = 1.0;
+            emitters_.push_back(std::move(e));
+        }
+    }
+    for (std::size_t i = 0; i < emitters_.size(); ++i) {
+        Emitter& e = emitters_[i];
+        if (e.kind != Kind::kPoint) {
+            e.power = std::max(0.0, luminance(e.radiance)) * e.area / (4 * kPi);
+            by_object_.emplace(e.object, i);
+        }
+    }
+}
+
+std::optional<std::size_t> Emitters::index_of(const Object* object) const {
+    const auto it = by_object_.find(object);
+    if (it == by_object_.end()) return std::nullopt;
+    return it->second;
+}
+
+std::optional<EmitterSample> Emitters::sample(std::size_t i, const Vec3& x, Vec2 u,
+                                              double time) const {
+    const Emitter& e = emitters_[i];
+    switch (e.kind) {
+        case Kind::kPoint: {
+            const Vec3 v = e.position - x;
+            const double d2 = dot(v, v);
+            if (!(d2 > 0)) return std::nullopt;
+            const double d = std::sqrt(d2);
+            return EmitterSample{v / d, d, e.radiance / d2, 0};
+        }
+        case Kind::kSphere: {
+            const Vec3 centre = e.path->at(time);
+            const Vec3 to_centre = centre - x;
+            const double d2 = dot(to_centre, to_centre);
+            if (inside_sphere(d2, e.radius)) {
+                const Vec3 dir = sample_cone(u, -1.0);
+                const auto t = intersect_sphere(centre, e.radius, {x, dir, time}, {0, kInfinity});
+                if (!t) return std::nullopt;
+                return EmitterSample{dir, *t, e.radiance, 1 / (4 * kPi)};
+            }
+            const double d = std::sqrt(d2);
+            const double cos_max = std::sqrt(std::max(0.0, 1 - e.radius * e.radius / d2));
+            const ConeCoordinates c = cone_coordinates(u, cos_max);
+            const Vec3 dir = normalize(Frame::around(to_centre / d).to_world({c.x, c.y, c.cos_t}));
+            const double distance =
+                d * c.cos_t - std::sqrt(positive_part(e.radius * e.radius - d2 * c.sin2_t));
+            return EmitterSample{dir, distance, e.radiance,
+                                 1 / (2 * kPi * one_minus_cos_max(d2, e.radius))};
+        }
+        case Kind::kTriangles: {
+            const auto& cdf = e.area_cdf;
+            const std::size_t k = std::min<std::size_t>(
+                std::upper_bound(cdf.begin(), cdf.end(), u.x) - cdf.begin(), cdf.size() - 1);
+            const double lo = k == 0 ? 0.0 : cdf[k - 1];
+            // The pick's share of u.x, stretched back over [0, 1): a well-spread u stays so.
+            const double v = std::clamp((u.x - lo) / (cdf[k] - lo), 0.0, std::nextafter(1.0, 0.0));
+            const auto triangle = static_cast<std::uint32_t>(k);
+            const auto p = e.mesh->corners(triangle);
+            const double su = std::sqrt(v);
+            const double b1 = (1 - su), b2 = u.y * su;
+            const Vec3 point = e.path->at(time) + (p[0] * (1 - b1 - b2) + p[1] * b1 + p[2] * b2);
+            const Vec3 to_point = point - x;
+            const double d2 = dot(to_point, to_point);
+            if (!(d2 > 0)) return std::nullopt;
+            const double d = std::sqrt(d2);
+            const Vec3 dir = to_point / d;
+            const double cosine = std::abs(dot(e.mesh->geometric_normal(triangle), dir));
+            if (!(cosine > 0)) return std::nullopt;
+            return EmitterSample{dir, d, e.radiance, d2 / (e.area * cosine)};
+        }
+    }
+    return std::nullopt;
+}
+
+double Emitters::pdf(std::size_t i, const Vec3& x, const Vec3& point, const Vec3& normal,
+                     double time) const {
+    const Emitter& e = emitters_[i];
+    switch (e.kind) {
+        case Kind::kPoint:
+            return 0;
+        case Kind::kSphere: {
+            const Vec3 to_centre = e.path->at(time) - x;
+            const double d2 = dot(to_centre, to_centre);
+            if (inside_sphere(d2, e.radius)) return 1 / (4 * kPi);
+            return 1 / (2 * kPi * one_minus_cos_max(d2, e.radius));
+        }
+        case Kind::kTriangles: {
+            const Vec3 to_point = point - x;
+            const double d2 = dot(to_point, to_point);
+            const double cosine = std::abs(dot(normal, to_point)) / std::sqrt(d2);
+            return cosine > 0 ? d2 / (e.area * cosine) : 0;
+        }
+    }
+    return 0;
+}
+
+}  // namespace drt
