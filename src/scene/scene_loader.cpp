@@ -1,6 +1,5 @@
-// The scene file reader. Every element and attribute of ../shared/spec/scene-format.md is read
-// here, checked, and turned into the Scene the renderer uses; docs/scene-format.md is the
-// user-facing description of the same rules.
+// The scene file reader: every element and attribute of the scene format (docs/scene-format.md)
+// is read here, checked, and turned into the Scene the renderer uses.
 //
 // Loading takes two passes because a thesis scene may define materials after the objects that
 // use them: the first pass reads everything and keeps objects pending, the second resolves
@@ -769,7 +768,7 @@ class SceneReader {
                             }});
     }
 
-    // Triangles and meshes (../shared/spec/scene-format.md, "Triangles and meshes").
+    // Triangles and meshes (docs/scene-format.md, "Meshes").
 
     void read_triangle(const XMLElement& e) {
         Attributes in(e, context_);

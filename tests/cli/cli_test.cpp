@@ -1,4 +1,4 @@
-// The `drt` command line as outside users drive it (../shared/spec/cli.md): every test runs the
+// The `drt` command line as outside users drive it (docs/usage.md): every test runs the
 // built binary in a fresh folder and checks exit status, messages and the files left behind.
 #include <fcntl.h>
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
-// The (u, v) of planes and spheres, exactly as ../shared/spec/scene-format.md ("Image textures,
-// UV coordinates") states them.
+// The (u, v) of planes and spheres, exactly as docs/scene-format.md ("Image textures") states
+// them.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1083,7 +1083,7 @@ TEST_F(SceneFile, TrianglesFlattenedBySinglePrecisionAreCountedInTheirOwnWarning
 namespace drt {
 namespace {
 
-// Light transport (../shared/spec/scene-format.md, "Light transport").
+// Light transport (docs/scene-format.md, "Light transport").
 TEST(SceneLoaderLightTransport, IntegratorIsDistributedUnlessPathIsNamed) {
     EXPECT_EQ(load(in_scene("")).scene.settings.integrator, IntegratorKind::kDistributed);
     EXPECT_EQ(load(in_scene(R"(<Render Integrator="path"/>)")).scene.settings.integrator,

@@ -1,4 +1,4 @@
-// The `drt` command line (../shared/spec/cli.md): render, batch render, compare, info.
+// The `drt` command line (docs/usage.md): render, batch render, compare, info.
 #pragma once
 
 #include <iosfwd>

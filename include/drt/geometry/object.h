@@ -78,7 +78,7 @@ struct Shapes {
 struct SurfaceDetail {
     std::shared_ptr<const Texture> texture;  // replaces the material's kd; null = none
     std::optional<BumpMap> bump;
-    // Image-mapped surfaces (../shared/spec/scene-format.md, "Image textures, UV coordinates").
+    // Image-mapped surfaces (docs/scene-format.md, "Image textures").
     std::shared_ptr<const HeightMap> height_map;  // bumps instead of `bump`'s noise; null = none
     double texture_scale = 1;                     // a plane's (u, v) are its coordinates over this
     // A lone triangle's corner (u, v) for A, B, C: its own (u, v) are the barycentrics (b1, b2),

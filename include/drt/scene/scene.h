@@ -17,7 +17,7 @@
 namespace drt {
 
 // How light is carried: the thesis's distributed ray tracer, or unbiased path tracing
-// (../shared/spec/scene-format.md, "Light transport").
+// (docs/scene-format.md, "Light transport").
 enum class IntegratorKind { kDistributed, kPath };
 
 struct RenderSettings {
