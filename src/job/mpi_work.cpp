@@ -73,8 +73,7 @@ enum Tag : int {
 // a tile's render time, then, while nothing comes, twice as long each time, up to a fraction of
 // the time between the finished tiles it handles (Pace). Each wake-up takes the core from a
 // worker on a machine with as many workers as cores, and on a virtual machine a timer costs an
-// exit to the host besides: polling every 100 µs to 1 ms, the leader of 2 x 1 thread on Test4
-// woke 2,000 times a second for tiles that take 110 ms.
+// exit to the host besides, so a fixed short poll would wake far more often than tiles finish.
 constexpr auto kIdleLeast = std::chrono::microseconds(100);
 // Before any tile has been timed, and where tiles are quick, the longest sleep; a thousandth of
 // a second is still short against a tile of a scene worth several processes.
@@ -466,9 +465,8 @@ MpiJob::MpiJob() {
     transport_ = start_mpi(*module_);
     // A process's share of its machine is the one its default thread count takes (render):
     // under mpirun's default binding, `mpirun -n 1` on two cores got one. Where the shares fill
-    // the machine (`-n 2` on two cores: one core each) the binding stays, and it kept 2 x 1
-    // 2-8 % faster under load (docs/scale-out.md). Threads started from here on (workers, the
-    // communication thread) inherit it; MPI's own, started already, barely run.
+    // the machine (one core each) the binding stays: pinned processes run faster under load.
+    // Threads started from here on (workers, the communication thread) inherit the share.
     if (bound_by_mpirun_default()) widen_to_share(share_of_machine(local_size()));
 }
 
