@@ -4,6 +4,9 @@ but the standard library: tools/make-texture.py scenes/assets
   tiles.png   256 x 256: 8 x 8 tiles of alternating light and dark grey with thin mortar lines
               and a red mark in each tile's bottom-left corner, so orientation shows
   bumps.png   128 x 128: a grey height map of rounded cobbles (white high, black low)
+  sky.hdr     128 x 64 Radiance HDR (linear, uncompressed), an equirectangular environment: a
+              blue sky brightening to the horizon, a brown ground, and a small bright sun
+              25 degrees up at azimuth phi = 60 degrees (u = 1/6), for scenes/assets/sky.xml
 """
 import math
 import struct
@@ -26,6 +29,40 @@ def write_png(path, width, height, pixel):
     png += chunk(b"IDAT", zlib.compress(bytes(rows), 9))
     png += chunk(b"IEND", b"")
     Path(path).write_bytes(png)
+
+
+def write_hdr(path, width, height, pixel):
+    header = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y %d +X %d\n" % (height, width)
+    data = bytearray(header)
+    for y in range(height):  # top row first
+        for x in range(width):
+            colour = pixel(x, height - 1 - y, width, height)
+            m = max(colour)
+            if m < 1e-32:
+                data.extend((0, 0, 0, 0))
+                continue
+            mantissa, exponent = math.frexp(m)
+            scale = mantissa * 256 / m
+            data.extend(min(255, int(c * scale)) for c in colour)
+            data.append(exponent + 128)
+    Path(path).write_bytes(bytes(data))
+
+
+def sky(x, y, width, height):
+    """Radiance along the direction of texel (x, y), y from the bottom (docs/scene-format.md:
+    u = phi/2pi with phi = atan2(-dz, dx), v = 1 - theta/pi)."""
+    phi = 2 * math.pi * (x + 0.5) / width
+    theta = math.pi * (1 - (y + 0.5) / height)
+    d = (math.sin(theta) * math.cos(phi), math.cos(theta), -math.sin(theta) * math.sin(phi))
+    sun_elevation, sun_phi = math.radians(25), math.radians(60)
+    s = (math.cos(sun_elevation) * math.cos(sun_phi), math.sin(sun_elevation),
+         -math.cos(sun_elevation) * math.sin(sun_phi))
+    if sum(a * b for a, b in zip(d, s)) > math.cos(math.radians(4)):
+        return (250.0, 225.0, 190.0)
+    if d[1] < 0:
+        return (0.25, 0.2, 0.15)
+    t = d[1]
+    return (0.35 + 0.5 * (1 - t), 0.55 + 0.4 * (1 - t), 1.0)
 
 
 def tiles(x, y):
@@ -53,3 +90,4 @@ if __name__ == "__main__":
     out.mkdir(parents=True, exist_ok=True)
     write_png(out / "tiles.png", 256, 256, tiles)
     write_png(out / "bumps.png", 128, 128, bumps)
+    write_hdr(out / "sky.hdr", 128, 64, sky)

@@ -108,7 +108,7 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
         }
         if (seen) return seen->intensity();
     }
-    if (!hit) return scene_.background;
+    if (!hit) return scene_.environment ? scene_.environment->radiance(ray.dir) : scene_.background;
 
     const Material& m = hit->object->material();
     const SurfaceHit surface = surface_of(ray, *hit, depth, camera_, scene_.settings.samples);

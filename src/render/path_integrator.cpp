@@ -125,7 +125,19 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
             }
             if (seen) return result + throughput * seen->intensity();
         }
-        if (!hit) return result + throughput * scene_.background;
+        if (!hit && !scene_.environment) return result + throughput * scene_.background;
+        if (!hit) {
+            // The environment was also sampled by next-event estimation after a diffuse event.
+            double weight = 1;
+            const auto emitter = plan_.emitters.environment_index();
+            if (after_diffuse && emitter && strategy_ == Strategy::kLightOnly) {
+                weight = 0;
+            } else if (after_diffuse && emitter && strategy_ == Strategy::kMis) {
+                const double light = emitter_rays_[*emitter] * scene_.environment->pdf(ray.dir);
+                weight = power_heuristic(scatter_density, light);
+            }
+            return result + throughput * scene_.environment->radiance(ray.dir) * weight;
+        }
 
         const Material& m = hit->object->material();
         const SurfaceHit surface = hit->object->surface_at(ray, *hit);

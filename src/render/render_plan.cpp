@@ -142,6 +142,9 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
             case Emitters::Kind::kTriangles:
                 out << "emitting triangles (" << e.mesh->triangle_count() << ")";
                 break;
+            case Emitters::Kind::kEnvironment:
+                out << "environment map, intensity " << e.environment->intensity();
+                break;
         }
         out << ", power " << e.power << ", shadow rays per shading point " << plan.emitter_rays[i]
             << "\n";

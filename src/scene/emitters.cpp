@@ -78,6 +78,13 @@ Emitters::Emitters(const Scene& scene) {
             by_object_.emplace(e.object, i);
         }
     }
+    if (scene.environment) {
+        Emitter e;
+        e.kind = Kind::kEnvironment;
+        e.environment = scene.environment.get();
+        e.power = std::max(0.0, scene.environment->power());
+        emitters_.push_back(std::move(e));
+    }
 }
 
 std::optional<std::size_t> Emitters::index_of(const Object* object) const {
@@ -137,6 +144,11 @@ std::optional<EmitterSample> Emitters::sample(std::size_t i, const Vec3& x, Vec2
             if (!(cosine > 0)) return std::nullopt;
             return EmitterSample{dir, d, e.radiance, d2 / (e.area * cosine)};
         }
+        case Kind::kEnvironment: {
+            const auto s = e.environment->sample(u);
+            if (!s) return std::nullopt;
+            return EmitterSample{s->dir, kInfinity, s->radiance, s->pdf};
+        }
     }
     return std::nullopt;
 }
@@ -159,6 +171,8 @@ double Emitters::pdf(std::size_t i, const Vec3& x, const Vec3& point, const Vec3
             const double cosine = std::abs(dot(normal, to_point)) / std::sqrt(d2);
             return cosine > 0 ? d2 / (e.area * cosine) : 0;
         }
+        case Kind::kEnvironment:
+            return e.environment->pdf(normalize(point - x));
     }
     return 0;
 }

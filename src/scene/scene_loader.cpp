@@ -86,9 +86,9 @@ std::optional<std::string_view> nearest(std::string_view name,
 // Every element the format knows, wherever it may stand; an element from this list in the wrong
 // place is reported as misplaced rather than unknown.
 constexpr std::string_view kElementNames[] = {
-    "Scene",     "Image",    "Render",  "Background", "Ambient", "Camera", "DepthOfField",
-    "Materials", "Lights",   "Objects", "Light",      "Plane",   "Sphere", "MotionBlurPosition",
-    "Material",  "Triangle", "Mesh",
+    "Scene",     "Image",    "Render",  "Background",  "Ambient", "Camera", "DepthOfField",
+    "Materials", "Lights",   "Objects", "Light",       "Plane",   "Sphere", "MotionBlurPosition",
+    "Material",  "Triangle", "Mesh",    "Environment",
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -504,6 +504,7 @@ class SceneReader {
             {"Render", &SceneReader::read_render, true},
             {"Background", &SceneReader::read_background, true},
             {"Ambient", &SceneReader::read_ambient, true},
+            {"Environment", &SceneReader::read_environment, true},
             {"Camera", &SceneReader::read_camera, true},
             {"DepthOfField", &SceneReader::read_depth_of_field, true},
             {"Materials", &SceneReader::read_materials},
@@ -592,6 +593,30 @@ class SceneReader {
 
     void read_background(const XMLElement& e) { scene_.background = read_rgb(e); }
     void read_ambient(const XMLElement& e) { scene_.ambient = read_rgb(e); }
+
+    // An equirectangular radiance map (environment.h), read through the scene's texture cache
+    // as a colour image; its sampling distribution is built here, once per scene.
+    void read_environment(const XMLElement& e) {
+        Attributes in(e, context_);
+        const std::string file = in.text("File");
+        const double intensity = in.number("Intensity", 1);
+        in.check(intensity >= 0, "Intensity", "non-negative");
+        const double rotate_y = in.number("RotateY", 0) * (kPi / 180);
+        const std::filesystem::path path =
+            std::filesystem::path(context_.file()).parent_path() / file;
+        const std::size_t before = textures_.files_read();
+        std::shared_ptr<const MipMap> image;
+        try {
+            image = textures_.get(path, TextureEncoding::kColor);
+        } catch (const ImageError& error) {
+            in.fail(error.what());
+        }
+        if (textures_.files_read() > before) files_read_.push_back(path);
+        scene_.environment =
+            std::make_shared<const Environment>(std::move(image), intensity, rotate_y);
+        in.warn_unknown();
+        warn_children(e);
+    }
 
     Color read_rgb(const XMLElement& e) {
         Attributes in(e, context_);

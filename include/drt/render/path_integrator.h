@@ -6,8 +6,9 @@
 // estimation sends ShadowRays shadow rays to the lights and emitters (shared by power as in the
 // distributed integrator); light from an emitter is found both by them and by the scattered ray,
 // and the two estimates are weighed by Veach's power heuristic, so nothing is counted twice.
-// Background is the radiance of every escaping ray; Ambient is not used. Paths end after MaxDepth
-// scattering events, or earlier by Russian roulette, whose survivors carry 1/(survival
+// Background, or the environment when there is one, is the radiance of every escaping ray; the
+// environment is also an emitter, weighed the same way. Ambient is not used. Paths end after
+// MaxDepth scattering events, or earlier by Russian roulette, whose survivors carry 1/(survival
 // probability) more so that the mean stays exact.
 #pragma once
 

@@ -2,7 +2,9 @@
 // triangle mesh) and Falloff-1 point lights, as next-event estimation samples them. Spheres are
 // sampled by the solid angle they subtend, a mesh by area over its triangles (one emitted
 // radiance per mesh, so area is its power distribution), a Falloff-1 point light is a point.
-// Emitting planes are infinite: they are seen by rays and found by scattered rays only.
+// Emitting planes are infinite: they are seen by rays and found by scattered rays only. The
+// scene's environment, if any, is the last emitter, sampled by its own distribution
+// (environment.h) at an infinite distance.
 #pragma once
 
 #include <cstdint>
@@ -26,7 +28,7 @@ struct EmitterSample {
 
 class Emitters {
   public:
-    enum class Kind { kPoint, kSphere, kTriangles };
+    enum class Kind { kPoint, kSphere, kTriangles, kEnvironment };
     struct Emitter {
         Kind kind = Kind::kPoint;
         Color radiance;                    // a point's intensity I
@@ -37,14 +39,16 @@ class Emitters {
         const TriangleMesh* mesh = nullptr;
         std::vector<double> area_cdf;  // a mesh's triangles by area, the last exactly 1
         double area = 0;               // a sphere's or mesh's whole surface
+        const Environment* environment = nullptr;
         // What next-event estimation shares shadow rays by, in the units of a thesis light's
         // luminance(I): luminance(I) for a point, luminance(radiance)·area/(4π) for a surface
-        // (so a Falloff-1 sphere light of intensity I has the power of a point light of I).
+        // (so a Falloff-1 sphere light of intensity I has the power of a point light of I);
+        // Environment::power for the environment.
         double power = 0;
     };
 
     // Every Falloff-1 point light, in scene order, then every emitting sphere and mesh (not
-    // plane), in object order.
+    // plane), in object order, then the environment.
     Emitters() = default;
     explicit Emitters(const Scene& scene);
 
@@ -61,6 +65,11 @@ class Emitters {
                double time) const;
     // Which emitter an object is, if it is sampled as one.
     std::optional<std::size_t> index_of(const Object* object) const;
+    // Which emitter the environment is, if there is one.
+    std::optional<std::size_t> environment_index() const {
+        if (emitters_.empty() || emitters_.back().kind != Kind::kEnvironment) return std::nullopt;
+        return emitters_.size() - 1;
+    }
 
   private:
     std::vector<Emitter> emitters_;

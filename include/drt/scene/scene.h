@@ -10,6 +10,7 @@
 
 #include "drt/geometry/object.h"
 #include "drt/scene/camera.h"
+#include "drt/scene/environment.h"
 #include "drt/scene/light.h"
 #include "drt/shading/material.h"
 #include "drt/util/color.h"
@@ -46,6 +47,9 @@ struct Scene {
     std::string path;  // the file it came from, for messages
     RenderSettings settings;
     Color background;
+    // <Environment>: when present, escaping rays see it instead of Background, and it lights
+    // diffuse surfaces as an emitter (emitters.h).
+    std::shared_ptr<const Environment> environment;
     Color ambient;
     std::optional<LookAt> view;  // absent: the thesis's pixel-plane camera
     Lens lens;
