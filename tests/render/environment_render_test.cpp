@@ -143,8 +143,8 @@ double rmse(const Image& a, const Image& b) {
 }
 
 // A floor with a sphere on it, lit by the sun environment: at equal shadow rays, importance
-// sampling's error against a many-ray reference is a fraction of uniform sampling's (measured
-// about 1/10), which would find the sun with a few rays in ten thousand.
+// sampling's error against a many-ray reference is under an eighth of uniform sampling's (measured
+// about 1/25), which finds the sun with a few rays in ten thousand.
 TEST(EnvironmentRender, ImportanceSamplingIsLessNoisyThanUniformSampling) {
     const auto scene = [](int shadow_rays, Environment::Sampling sampling) {
         Scene s = from_xml(R"(<Scene><Image Width="24" Height="24"/>
@@ -163,7 +163,7 @@ TEST(EnvironmentRender, ImportanceSamplingIsLessNoisyThanUniformSampling) {
     const double uniform =
         rmse(render_with(scene(16, Environment::Sampling::kUniform)).image, reference);
     EXPECT_GT(importance, 0);
-    EXPECT_LT(importance * 4, uniform) << importance << " " << uniform;
+    EXPECT_LT(importance * 8, uniform) << importance << " " << uniform;
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <memory>
@@ -146,6 +147,24 @@ TEST(Environment, DensityIntegratesToOneAndImportanceSamplingIsUnbiased) {
         EXPECT_LT(error / integral, 0.0015);
         EXPECT_NEAR(estimate / integral, 1.0, 0.006);
     }
+}
+
+// Everything the environment works out from a 4096 x 2048 map (its luminance, the dilation, the
+// distribution, its power) stays well under a second; the mip-map is the texture cache's.
+TEST(Environment, BuildsFromAFullSizeMapQuickly) {
+    constexpr int w = 4096, h = 2048;
+    Image image(w, h);
+    for (std::size_t k = 0; k < image.rgb.size(); ++k) {
+        image.rgb[k] = static_cast<float>((k * 2654435761u) % 1000) / 100;
+    }
+    const auto map = std::make_shared<const MipMap>(image);
+    const auto start = std::chrono::steady_clock::now();
+    const Environment env(map, 1, 0);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    RecordProperty("build_seconds", std::to_string(seconds));
+    EXPECT_LT(seconds, 1.0);
+    EXPECT_GT(env.power(), 0);
 }
 
 class EnvironmentScene : public test::TempFolderTest {
