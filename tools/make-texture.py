@@ -58,11 +58,11 @@ def sky(x, y, width, height):
     s = (math.cos(sun_elevation) * math.cos(sun_phi), math.sin(sun_elevation),
          -math.cos(sun_elevation) * math.sin(sun_phi))
     if sum(a * b for a, b in zip(d, s)) > math.cos(math.radians(4)):
-        return (250.0, 225.0, 190.0)
+        return (600.0, 540.0, 450.0)
     if d[1] < 0:
         return (0.25, 0.2, 0.15)
     t = d[1]
-    return (0.35 + 0.5 * (1 - t), 0.55 + 0.4 * (1 - t), 1.0)
+    return (0.15 + 0.3 * (1 - t), 0.25 + 0.25 * (1 - t), 0.5)
 
 
 def tiles(x, y):
