@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "drt/render/path_integrator.h"
@@ -129,6 +130,24 @@ TEST(EnvironmentRender, PathIntegratorsEstimatorsOfTheEnvironmentAgree) {
         expect_relative(floor_estimate(strategy, 100000), expected, 0.01,
                         "strategy " + std::to_string(static_cast<int>(strategy)));
     }
+}
+
+// The environment shares ShadowRays with an area light by power, as emitters do: a uniform
+// environment of luminance 1 has power 2 (∫ L dω / 2π), a sphere light of intensity 5 power 5,
+// so of 16 rays each has one and the other 14 split 5 : 2, 10 and 4: 11 and 5.
+TEST(EnvironmentRender, ShadowRaysAreSharedWithTheLightsByPower) {
+    Scene scene = from_xml(R"(<Scene><Render ShadowRays="16"/>
+      <Materials><White diffuse="1" kdr="1" kdg="1" kdb="1"/></Materials>
+      <Light Px="0" Py="10" Pz="0" Radius="1" Ir="5" Ig="5" Ib="5"/>
+      <Sphere Px="0" Py="0" Pz="0" Radius="1" Material="White"/></Scene>)");
+    scene.environment = uniform_environment({1, 1, 1});
+    EXPECT_NEAR(scene.environment->power(), 2, 0.02);  // its 8 rows by the midpoint rule
+    const RenderPlan plan = plan_render(scene);
+    ASSERT_EQ(plan.emitters.size(), 1u);
+    ASSERT_EQ(plan.emitters.environment_index(), std::optional<std::size_t>(0));
+    EXPECT_EQ(plan.shadow_rays[0], 11);
+    EXPECT_EQ(plan.emitter_rays[0], 5);
+    EXPECT_TRUE(plan.effects.soft_shadows);
 }
 
 double rmse(const Image& a, const Image& b) {
