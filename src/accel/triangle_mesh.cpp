@@ -47,7 +47,7 @@ void TriangleMesh::take(const ObjMesh& obj, const MeshTransform& transform, bool
         placed[i] = rotation(obj.positions[i] * transform.scale);
         box.grow(placed[i]);
     }
-    origin_ = box.empty() ? Vec3{} : box.centre();
+    origin_ = transform.origin ? *transform.origin : box.empty() ? Vec3{} : box.centre();
 
     // A vertex is a position, or with smooth shading a position and the file's normal there:
     // one index buffer serves both.
