@@ -163,15 +163,17 @@ class ObjParser {
             fail("f: a face needs at least 3 vertices, got " + std::to_string(corners_.size()));
         const bool has_texcoords = std::ranges::any_of(
             corners_, [](const Corner& c) { return c.texcoord != ObjMesh::kNoTexcoord; });
-        if (has_texcoords && mesh_.texcoord_indices.empty())
+        if (has_texcoords && !texcoords_used_) {
             mesh_.texcoord_indices.assign(mesh_.position_indices.size(), ObjMesh::kNoTexcoord);
+            texcoords_used_ = true;
+        }
         if (current_material_ == ObjMesh::kNoMaterial && mesh_.first_face_without_material == 0)
             mesh_.first_face_without_material = line_;
         for (std::size_t i = 1; i + 1 < corners_.size(); ++i) {
             for (const Corner& c : {corners_[0], corners_[i], corners_[i + 1]}) {
                 mesh_.position_indices.push_back(c.position);
                 mesh_.normal_indices.push_back(c.normal);
-                if (!mesh_.texcoord_indices.empty()) mesh_.texcoord_indices.push_back(c.texcoord);
+                if (texcoords_used_) mesh_.texcoord_indices.push_back(c.texcoord);
             }
             if (material_used_) mesh_.triangle_materials.push_back(current_material_);
         }
@@ -225,7 +227,8 @@ class ObjParser {
     ObjMesh mesh_;
     std::map<std::string, std::uint32_t, std::less<>> material_slots_;  // name -> its index
     std::uint32_t current_material_ = ObjMesh::kNoMaterial;
-    bool material_used_ = false;  // whether a `usemtl` has been read
+    bool material_used_ = false;   // whether a `usemtl` has been read
+    bool texcoords_used_ = false;  // whether a face corner has named a `vt`
     int line_ = 0;
     std::vector<Corner> corners_;  // of the current face, kept to reuse its memory
 };

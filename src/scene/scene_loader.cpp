@@ -413,6 +413,11 @@ class SceneReader {
         std::function<std::unique_ptr<Object>(const Material&, SurfaceDetail)> make;
         const Material* own_material = nullptr;  // an OBJ file's, used instead of `material`
     };
+    // A material of an OBJ file's library and the MTL file it came from (its images' folder).
+    struct LibraryMaterial {
+        MtlMaterial mtl;
+        std::filesystem::path mtl_path;
+    };
 
     void parse_xml(std::string_view xml, tinyxml2::XMLDocument& doc) const {
         // tinyxml2 silently stops at a nul byte, which would read half a binary file as a scene.
@@ -815,9 +820,7 @@ class SceneReader {
         transform.rotate_degrees = in.vec3("RotateX", "RotateY", "RotateZ", {});
         const bool smooth = in.flag("Smooth", true);
         SurfaceSpec surface = read_surface(in);
-        // A mesh's (u, v) come from its OBJ file's `vt`, which the OBJ reader does not keep yet.
-        if (surface.image_texture() || !surface.bump_file.empty())
-            in.fail("image textures and BumpFile on a Mesh are not supported yet");
+        load_images(in, surface);
         in.warn_unknown();
         warn_stray_text(e);
         read_motion(e, "Tx", "Ty", "Tz", path);
@@ -838,6 +841,7 @@ class SceneReader {
             read_obj_parts(e, in, obj_path, std::move(obj), transform, smooth, surface, path);
             return;
         }
+        if (!reads_uv(surface)) drop_texcoords(obj);
         auto mesh = build_mesh(in, std::move(obj), transform, smooth);
         if (const std::size_t n = mesh->dropped(); n > 0) {
             context_.warn(e, std::to_string(n) + (n == 1 ? " triangle" : " triangles") +
@@ -859,7 +863,7 @@ class SceneReader {
     void read_obj_parts(const XMLElement& e, const Attributes& in,
                         const std::filesystem::path& obj_path, ObjMesh obj, MeshTransform transform,
                         bool smooth, const SurfaceSpec& surface, const std::vector<Vec3>& path) {
-        const std::map<std::string, MtlMaterial, std::less<>> library =
+        const std::map<std::string, LibraryMaterial, std::less<>> library =
             read_material_libraries(obj, obj_path);
         const Rotation rotation(transform.rotate_degrees);
         Bounds box;
@@ -874,17 +878,22 @@ class SceneReader {
         std::vector<ObjPart> parts = split_by_material(obj, smooth);
         for (ObjPart& part : parts) {
             auto material = std::make_unique<Material>(default_obj_material());
+            SurfaceSpec part_surface = surface;
             if (part.material == ObjMesh::kNoMaterial) {
                 grey_from(obj.first_face_without_material);
             } else {
                 const ObjReference& name = obj.material_names[part.material];
                 const auto found = library.find(name.name);
                 if (found != library.end()) {
-                    *material = material_from_mtl(found->second);
+                    *material = material_from_mtl(found->second.mtl);
+                    // The scene's own texture, when the Mesh names one, stands over map_Kd.
+                    if (!part_surface.image && !part_surface.textured)
+                        part_surface.image = colour_map(found->second);
                 } else {
                     grey_from(name.line);
                 }
             }
+            if (!reads_uv(part_surface)) drop_texcoords(part.mesh);
             auto mesh = build_mesh(in, std::move(part.mesh), transform, smooth);
             dropped += mesh->dropped();
             collapsed += mesh->collapsed();
@@ -892,7 +901,7 @@ class SceneReader {
             obj_materials_.push_back(std::move(material));
             pending_.push_back({&e,
                                 {},
-                                surface,
+                                std::move(part_surface),
                                 [mesh = std::move(mesh), path](const Material& m, SurfaceDetail d) {
                                     return std::make_unique<Mesh>(mesh, path, m, std::move(d));
                                 },
@@ -916,9 +925,9 @@ class SceneReader {
 
     // The materials of an OBJ file's `mtllib` statements by name (the first definition of a
     // name counts). A missing library is a warning at its `mtllib` line.
-    std::map<std::string, MtlMaterial, std::less<>> read_material_libraries(
+    std::map<std::string, LibraryMaterial, std::less<>> read_material_libraries(
         const ObjMesh& obj, const std::filesystem::path& obj_path) {
-        std::map<std::string, MtlMaterial, std::less<>> library;
+        std::map<std::string, LibraryMaterial, std::less<>> library;
         const std::filesystem::path folder = obj_path.parent_path();
         for (const ObjReference& statement : obj.material_libraries) {
             for (const std::filesystem::path& mtl_path : library_files(statement.name, folder)) {
@@ -937,7 +946,7 @@ class SceneReader {
                 for (MtlMaterial& m : materials) {
                     warn_missing_images(m, mtl_path);
                     const std::string name = m.name;
-                    library.try_emplace(name, std::move(m));
+                    library.try_emplace(name, LibraryMaterial{std::move(m), mtl_path});
                 }
             }
         }
@@ -967,18 +976,46 @@ class SceneReader {
     }
 
     // Images of an MTL material: a missing one is warned about at its line and its constant
-    // colour stands; one that exists is not applied to meshes yet, which is said too.
+    // colour stands; an alpha or bump map that exists is not applied yet, which is said too.
     void warn_missing_images(const MtlMaterial& m, const std::filesystem::path& mtl_path) {
         for (const auto* image : {&m.map_kd, &m.map_d, &m.bump}) {
             if (!*image) continue;
             const std::filesystem::path file = mtl_path.parent_path() / (*image)->path;
             std::error_code error;
-            const std::string what = std::filesystem::is_regular_file(file, error)
-                                         ? "images on meshes are not applied yet"
-                                         : "cannot open " + file.string();
+            const bool exists = std::filesystem::is_regular_file(file, error);
+            if (exists && image == &m.map_kd) continue;
+            const std::string what = exists ? "alpha and bump maps of OBJ materials are not "
+                                              "applied yet"
+                                            : "cannot open " + file.string();
             context_.warn_in(mtl_path.string(), (*image)->line,
                              what + "; the material's constant colour is used");
         }
+    }
+
+    // An MTL material's map_Kd through the scene's cache; null (the constant colour) when it has
+    // none, or one that cannot be read, which is a warning at its line.
+    std::shared_ptr<const MipMap> colour_map(const LibraryMaterial& m) {
+        if (!m.mtl.map_kd) return nullptr;
+        const std::filesystem::path file = m.mtl_path.parent_path() / m.mtl.map_kd->path;
+        std::error_code error;
+        if (!std::filesystem::is_regular_file(file, error)) return nullptr;  // warned already
+        const std::size_t before = textures_.files_read();
+        try {
+            auto image = textures_.get(file, TextureEncoding::kColor);
+            if (textures_.files_read() > before) files_read_.push_back(file);
+            return image;
+        } catch (const ImageError& e) {
+            context_.warn_in(m.mtl_path.string(), m.mtl.map_kd->line,
+                             std::string(e.what()) + "; the material's constant colour is used");
+            return nullptr;
+        }
+    }
+
+    static bool reads_uv(const SurfaceSpec& surface) { return surface.image || surface.height; }
+    // Texture coordinates no texture reads are not kept: a mesh stays as lean as without them.
+    static void drop_texcoords(ObjMesh& obj) {
+        obj.texcoords = {};
+        obj.texcoord_indices = {};
     }
 
     // The images a surface names, relative to the scene file's folder, through the scene's cache.

@@ -226,6 +226,11 @@ TEST(ObjReaderMaterials, ReadsLibrariesAndTheMaterialOfEachTriangle) {
     EXPECT_EQ(m.triangle_count(), 5u);
 }
 
+TEST(ObjReaderUv, TheFirstFaceMayNameTextureCoordinates) {
+    const ObjMesh m = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5 0.5\nf 1/1 2 3/1\n", "m.obj");
+    EXPECT_EQ(m.texcoord_indices, (std::vector<std::uint32_t>{0, kNoUv, 0}));
+}
+
 TEST(ObjReaderMaterials, AFileWithoutUsemtlKeepsNoPerTriangleMaterials) {
     const ObjMesh m = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "m.obj");
     EXPECT_TRUE(m.triangle_materials.empty());
