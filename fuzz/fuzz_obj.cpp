@@ -16,6 +16,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         for (const std::uint32_t i : mesh.normal_indices) {
             if (i != drt::ObjMesh::kNoNormal && i >= mesh.normals.size()) __builtin_trap();
         }
+        for (const std::uint32_t i : mesh.texcoord_indices) {
+            if (i != drt::ObjMesh::kNoTexcoord && i >= mesh.texcoords.size()) __builtin_trap();
+        }
+        if (!mesh.texcoord_indices.empty() &&
+            mesh.texcoord_indices.size() != mesh.position_indices.size())
+            __builtin_trap();
+        if (!mesh.triangle_materials.empty() &&
+            mesh.triangle_materials.size() != mesh.triangle_count())
+            __builtin_trap();
+        for (const std::uint32_t i : mesh.triangle_materials) {
+            if (i != drt::ObjMesh::kNoMaterial && i >= mesh.material_names.size()) __builtin_trap();
+        }
     } catch (const drt::ObjError&) {
     }
     return 0;

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (clang, ASan + UBSan) in build-fuzz/ and runs one of them.
-# Usage: tools/fuzz.sh TARGET [SECONDS]     TARGET: scene, image, cli, obj or texture; default 60 seconds
+# Usage: tools/fuzz.sh TARGET [SECONDS]     TARGET: scene, image, cli, obj, texture or mtl; default 60 seconds
 #        tools/fuzz.sh --build               only build
 # The corpus grows in build-fuzz/corpus/TARGET, seeded from fuzz/corpus/TARGET (scene: scenes/).
 # A crash leaves build-fuzz/crash-TARGET-* and makes the script fail: turn it into a regression
@@ -8,7 +8,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)  # absolute paths throughout: the cli target changes its working folder
-target=${1:?usage: tools/fuzz.sh scene|image|cli|obj|texture [SECONDS] | --build}
+target=${1:?usage: tools/fuzz.sh scene|image|cli|obj|texture|mtl [SECONDS] | --build}
 seconds=${2:-60}
 
 # DRT_FUZZ_BUILT=1 skips the build step (tools/test.sh builds once, then runs targets side by side).
@@ -30,7 +30,7 @@ fi
 [ "$target" = --build ] && exit 0
 
 binary=$root/build-fuzz/fuzz/fuzz_$target
-[ -x "$binary" ] || { echo "fuzz.sh: no target '$target' (scene, image, cli, obj, texture)" >&2; exit 2; }
+[ -x "$binary" ] || { echo "fuzz.sh: no target '$target' (scene, image, cli, obj, texture, mtl)" >&2; exit 2; }
 corpus=$root/build-fuzz/corpus/$target
 mkdir -p "$corpus"
 if [ "$target" = scene ]; then

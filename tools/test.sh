@@ -40,4 +40,4 @@ fuzz_pair() {
 }
 fuzz_pair scene image
 fuzz_pair cli obj
-DRT_FUZZ_BUILT=1 tools/fuzz.sh texture 50
+fuzz_pair texture mtl

@@ -1,5 +1,6 @@
 #include "drt/accel/mesh.h"
 
+#include <cmath>
 #include <utility>
 
 namespace drt {
@@ -49,7 +50,17 @@ Object::SurfaceCoordinates Mesh::locate(const Ray& ray, const Hit& hit, SurfaceH
 
 SurfaceUv Mesh::surface_uv(const Ray&, const Hit& hit, const SurfaceHit&) const {
     const auto [a, b, c] = mesh_->corners(hit.primitive);
-    return {hit.uv, b - a, c - a};
+    const Vec3 e1 = b - a, e2 = c - a;
+    if (!mesh_->has_texcoords()) return {hit.uv, e1, e2};
+    const auto [ta, tb, tc] = mesh_->corner_texcoords(hit.primitive);
+    const double w0 = 1 - hit.uv.x - hit.uv.y, w1 = hit.uv.x, w2 = hit.uv.y;
+    const Vec2 uv{ta.x * w0 + tb.x * w1 + tc.x * w2, ta.y * w0 + tb.y * w1 + tc.y * w2};
+    // How the point moves along u and v: the edges solved against their (u, v) differences.
+    const double du1 = tb.x - ta.x, dv1 = tb.y - ta.y, du2 = tc.x - ta.x, dv2 = tc.y - ta.y;
+    const double det = du1 * dv2 - dv1 * du2;
+    if (det == 0 || !std::isfinite(1 / det)) return {uv, e1, e2};  // corners share a (u, v)
+    const double inv = 1 / det;
+    return {uv, (e1 * dv2 - e2 * dv1) * inv, (e2 * du1 - e1 * du2) * inv};
 }
 
 }  // namespace drt

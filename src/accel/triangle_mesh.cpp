@@ -47,7 +47,7 @@ void TriangleMesh::take(const ObjMesh& obj, const MeshTransform& transform, bool
         placed[i] = rotation(obj.positions[i] * transform.scale);
         box.grow(placed[i]);
     }
-    origin_ = box.empty() ? Vec3{} : box.centre();
+    origin_ = transform.origin ? *transform.origin : box.empty() ? Vec3{} : box.centre();
 
     // A vertex is a position, or with smooth shading a position and the file's normal there:
     // one index buffer serves both.
@@ -98,6 +98,16 @@ void TriangleMesh::take(const ObjMesh& obj, const MeshTransform& transform, bool
         }
         const std::uint32_t* n = &obj.normal_indices[c];
         triangles_.push_back({vertex(p[0], n[0]), vertex(p[1], n[1]), vertex(p[2], n[2])});
+        if (!obj.texcoord_indices.empty()) {
+            std::array<float, 6> uv{};
+            for (std::size_t k = 0; k < 3; ++k) {
+                const std::uint32_t i = obj.texcoord_indices[c + k];
+                if (i == ObjMesh::kNoTexcoord) continue;
+                uv[2 * k] = static_cast<float>(obj.texcoords[i].x);
+                uv[2 * k + 1] = static_cast<float>(obj.texcoords[i].y);
+            }
+            texcoords_.push_back(uv);
+        }
     }
 
     if (file_normals) {
@@ -174,7 +184,8 @@ Vec3 TriangleMesh::lifted(std::uint32_t triangle, const Barycentrics& b) const {
 
 std::size_t TriangleMesh::bytes() const {
     return positions_.capacity() * sizeof(Float3) + normals_.capacity() * sizeof(Float3) +
-           triangles_.capacity() * sizeof(triangles_[0]) + tree_.memory() + sizeof(*this);
+           triangles_.capacity() * sizeof(triangles_[0]) +
+           texcoords_.capacity() * sizeof(texcoords_[0]) + tree_.memory() + sizeof(*this);
 }
 
 void TriangleMesh::build_hierarchy(int threads) {
@@ -187,6 +198,12 @@ void TriangleMesh::build_hierarchy(int threads) {
     prefer_huge_pages(ordered);
     for (const std::uint32_t t : tree.order) ordered.push_back(triangles_[t]);
     triangles_ = std::move(ordered);
+    if (!texcoords_.empty()) {
+        std::vector<std::array<float, 6>> uv_ordered;
+        uv_ordered.reserve(texcoords_.size());
+        for (const std::uint32_t t : tree.order) uv_ordered.push_back(texcoords_[t]);
+        texcoords_ = std::move(uv_ordered);
+    }
     order_vertices_by_leaves();
 }
 

@@ -3,8 +3,10 @@
 // names no line, and accepts "3x" as 3 — all of which the scene format calls errors.
 #include "drt/io/obj_reader.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <map>
 #include <string>
 
 #include "drt/util/file_reader.h"
@@ -33,6 +35,14 @@ class Tokens {
         const std::string_view token = rest_.substr(i, j - i);
         rest_.remove_prefix(j);
         return token;
+    }
+
+    // The rest of the line without its leading and trailing blanks: a name that may hold spaces.
+    std::string_view rest() const {
+        std::string_view r = rest_;
+        while (!r.empty() && is_blank(r.front())) r.remove_prefix(1);
+        while (!r.empty() && is_blank(r.back())) r.remove_suffix(1);
+        return r;
     }
 
   private:
@@ -66,7 +76,7 @@ class ObjParser {
 
   private:
     struct Corner {
-        std::uint32_t position, normal;
+        std::uint32_t position, normal, texcoord;
     };
 
     void statement(std::string_view line) {
@@ -81,11 +91,40 @@ class ObjParser {
             if (const std::string_view extra = tokens.next(); !extra.empty())
                 fail("vn: more than 3 coordinates: \"" + abbreviated(extra) + "\"");
         } else if (keyword == "vt") {
-            // Unused, but counted, so that a face's texture index can be checked.
-            ++texture_count_;
+            mesh_.texcoords.push_back(texcoord(tokens));
         } else if (keyword == "f") {
             face(tokens);
+        } else if (keyword == "mtllib") {
+            mesh_.material_libraries.push_back({std::string(tokens.rest()), line_});
+        } else if (keyword == "usemtl") {
+            use_material(tokens.rest());
         }
+    }
+
+    // "vt u [v [w]]": v is 0 when absent, w (a 3-D texture's) is read but unused.
+    Vec2 texcoord(Tokens& tokens) {
+        double c[3] = {0, 0, 0};
+        int count = 0;
+        for (std::string_view t = tokens.next(); !t.empty(); t = tokens.next()) {
+            if (count == 3) fail("vt: more than 3 coordinates: \"" + abbreviated(t) + "\"");
+            c[count++] = number(t, "vt");
+        }
+        if (count == 0) fail("vt: 1 to 3 coordinates needed, got 0");
+        return {c[0], c[1]};
+    }
+
+    void use_material(std::string_view name) {
+        const auto known = material_slots_.find(name);
+        if (known != material_slots_.end()) {
+            current_material_ = known->second;
+        } else {
+            current_material_ = static_cast<std::uint32_t>(mesh_.material_names.size());
+            mesh_.material_names.push_back({std::string(name), line_});
+            material_slots_.emplace(std::string(name), current_material_);
+        }
+        if (!material_used_)
+            mesh_.triangle_materials.assign(mesh_.triangle_count(), ObjMesh::kNoMaterial);
+        material_used_ = true;
     }
 
     Vec3 point(Tokens& tokens, std::string_view keyword) {
@@ -122,11 +161,21 @@ class ObjParser {
             corners_.push_back(corner(t));
         if (corners_.size() < 3)
             fail("f: a face needs at least 3 vertices, got " + std::to_string(corners_.size()));
+        const bool has_texcoords = std::ranges::any_of(
+            corners_, [](const Corner& c) { return c.texcoord != ObjMesh::kNoTexcoord; });
+        if (has_texcoords && !texcoords_used_) {
+            mesh_.texcoord_indices.assign(mesh_.position_indices.size(), ObjMesh::kNoTexcoord);
+            texcoords_used_ = true;
+        }
+        if (current_material_ == ObjMesh::kNoMaterial && mesh_.first_face_without_material == 0)
+            mesh_.first_face_without_material = line_;
         for (std::size_t i = 1; i + 1 < corners_.size(); ++i) {
             for (const Corner& c : {corners_[0], corners_[i], corners_[i + 1]}) {
                 mesh_.position_indices.push_back(c.position);
                 mesh_.normal_indices.push_back(c.normal);
+                if (texcoords_used_) mesh_.texcoord_indices.push_back(c.texcoord);
             }
+            if (material_used_) mesh_.triangle_materials.push_back(current_material_);
         }
     }
 
@@ -134,13 +183,14 @@ class ObjParser {
     Corner corner(std::string_view token) {
         const std::size_t slash1 = token.find('/');
         const std::string_view position = token.substr(0, slash1);
-        Corner c{index(position, mesh_.positions.size(), "vertex", token), ObjMesh::kNoNormal};
+        Corner c{index(position, mesh_.positions.size(), "vertex", token), ObjMesh::kNoNormal,
+                 ObjMesh::kNoTexcoord};
         if (slash1 == std::string_view::npos) return c;
         const std::string_view rest = token.substr(slash1 + 1);
         const std::size_t slash2 = rest.find('/');
         const std::string_view texture = rest.substr(0, slash2);
         if (!texture.empty() || slash2 == std::string_view::npos)
-            index(texture, texture_count_, "texture", token);
+            c.texcoord = index(texture, mesh_.texcoords.size(), "texture", token);
         if (slash2 == std::string_view::npos) return c;
         c.normal = index(rest.substr(slash2 + 1), mesh_.normals.size(), "normal", token);
         return c;
@@ -175,7 +225,10 @@ class ObjParser {
     std::string_view text_;
     const std::string& name_;
     ObjMesh mesh_;
-    std::size_t texture_count_ = 0;
+    std::map<std::string, std::uint32_t, std::less<>> material_slots_;  // name -> its index
+    std::uint32_t current_material_ = ObjMesh::kNoMaterial;
+    bool material_used_ = false;   // whether a `usemtl` has been read
+    bool texcoords_used_ = false;  // whether a face corner has named a `vt`
     int line_ = 0;
     std::vector<Corner> corners_;  // of the current face, kept to reuse its memory
 };

@@ -23,10 +23,13 @@
 #include <vector>
 
 #include "drt/accel/mesh.h"
+#include "drt/geometry/mesh_transform.h"
 #include "drt/geometry/plane.h"
 #include "drt/geometry/sphere.h"
+#include "drt/io/mtl_reader.h"
 #include "drt/io/obj_reader.h"
 #include "drt/sampling/sampler.h"
+#include "drt/scene/obj_materials.h"
 #include "drt/scene/texture_cache.h"
 #include "drt/shading/image_texture.h"
 #include "drt/shading/texture.h"
@@ -138,9 +141,10 @@ class Context {
     void warn(const XMLElement& element, const std::string& message) {
         warn_at(element.GetLineNum(), message);
     }
-    void warn_at(int line, const std::string& message) {
-        warnings_.push_back(
-            printable(file_ + ":" + std::to_string(line) + ": warning: " + message));
+    void warn_at(int line, const std::string& message) { warn_in(file_, line, message); }
+    // About a line of another file that the scene reads (an OBJ or MTL file).
+    void warn_in(const std::string& file, int line, const std::string& message) {
+        warnings_.push_back(printable(file + ":" + std::to_string(line) + ": warning: " + message));
     }
     void warn_unknown_element(const XMLElement& element, const XMLElement& parent,
                               std::span<const std::string_view> allowed) {
@@ -382,6 +386,7 @@ class SceneReader {
         read_scene(root);
         resolve_objects();
         add_emitting_lights();
+        for (auto& m : obj_materials_) scene_.materials.push_back(std::move(m));
         if (const auto ambient = setting_lines_.find("Ambient");
             ambient != setting_lines_.end() &&
             scene_.settings.integrator == IntegratorKind::kPath) {
@@ -406,6 +411,12 @@ class SceneReader {
         std::string material;
         SurfaceSpec surface;
         std::function<std::unique_ptr<Object>(const Material&, SurfaceDetail)> make;
+        const Material* own_material = nullptr;  // an OBJ file's, used instead of `material`
+    };
+    // A material of an OBJ file's library and the MTL file it came from (its images' folder).
+    struct LibraryMaterial {
+        MtlMaterial mtl;
+        std::filesystem::path mtl_path;
     };
 
     void parse_xml(std::string_view xml, tinyxml2::XMLDocument& doc) const {
@@ -825,7 +836,8 @@ class SceneReader {
     void read_mesh(const XMLElement& e) {
         Attributes in(e, context_);
         const std::string file = in.text("File");
-        std::string material = in.text("Material");
+        // Without a Material, the mesh takes the OBJ file's own materials.
+        const std::optional<std::string_view> material = in.find("Material");
         std::vector<Vec3> path{in.vec3("Tx", "Ty", "Tz", {})};
         MeshTransform transform;
         transform.scale = in.number("Scale", 1);
@@ -833,9 +845,7 @@ class SceneReader {
         transform.rotate_degrees = in.vec3("RotateX", "RotateY", "RotateZ", {});
         const bool smooth = in.flag("Smooth", true);
         SurfaceSpec surface = read_surface(in);
-        // A mesh's (u, v) come from its OBJ file's `vt`, which the OBJ reader does not keep yet.
-        if (surface.image_texture() || !surface.bump_file.empty())
-            in.fail("image textures and BumpFile on a Mesh are not supported yet");
+        load_images(in, surface);
         in.warn_unknown();
         warn_stray_text(e);
         read_motion(e, "Tx", "Ty", "Tz", path);
@@ -852,6 +862,11 @@ class SceneReader {
         } catch (const ObjError& error) {
             throw SceneError(error.what());
         }
+        if (!material) {
+            read_obj_parts(e, in, obj_path, std::move(obj), transform, smooth, surface, path);
+            return;
+        }
+        if (!reads_uv(surface)) drop_texcoords(obj);
         auto mesh = build_mesh(in, std::move(obj), transform, smooth);
         if (const std::size_t n = mesh->dropped(); n > 0) {
             context_.warn(e, std::to_string(n) + (n == 1 ? " triangle" : " triangles") +
@@ -862,10 +877,170 @@ class SceneReader {
                                  obj_path.string() + " too thin for single precision dropped");
         }
         pending_.push_back(
-            {&e, std::move(material), std::move(surface),
+            {&e, std::string(*material), std::move(surface),
              [mesh = std::move(mesh), path = std::move(path)](const Material& m, SurfaceDetail d) {
                  return std::make_unique<Mesh>(mesh, path, m, std::move(d));
              }});
+    }
+
+    // A mesh in the OBJ file's own materials: one Mesh object per material, all sharing the
+    // file's origin so that their common edges stay closed.
+    void read_obj_parts(const XMLElement& e, const Attributes& in,
+                        const std::filesystem::path& obj_path, ObjMesh obj, MeshTransform transform,
+                        bool smooth, const SurfaceSpec& surface, const std::vector<Vec3>& path) {
+        const std::map<std::string, LibraryMaterial, std::less<>> library =
+            read_material_libraries(obj, obj_path);
+        const Rotation rotation(transform.rotate_degrees);
+        Bounds box;
+        for (const Vec3& p : obj.positions) box.grow(rotation(p * transform.scale));
+        transform.origin = box.empty() ? Vec3{} : box.centre();
+
+        int grey_line = 0;  // the first line whose faces get the default grey
+        const auto grey_from = [&](int line) {
+            grey_line = grey_line == 0 ? line : std::min(grey_line, line);
+        };
+        std::size_t dropped = 0, collapsed = 0;
+        std::vector<ObjPart> parts = split_by_material(obj, smooth);
+        for (ObjPart& part : parts) {
+            auto material = std::make_unique<Material>(default_obj_material());
+            SurfaceSpec part_surface = surface;
+            if (part.material == ObjMesh::kNoMaterial) {
+                grey_from(obj.first_face_without_material);
+            } else {
+                const ObjReference& name = obj.material_names[part.material];
+                const auto found = library.find(name.name);
+                if (found != library.end()) {
+                    *material = material_from_mtl(found->second.mtl);
+                    // The scene's own texture, when the Mesh names one, stands over map_Kd.
+                    if (!part_surface.image && !part_surface.textured)
+                        part_surface.image = colour_map(found->second);
+                } else {
+                    grey_from(name.line);
+                }
+            }
+            if (!reads_uv(part_surface)) drop_texcoords(part.mesh);
+            auto mesh = build_mesh(in, std::move(part.mesh), transform, smooth);
+            dropped += mesh->dropped();
+            collapsed += mesh->collapsed();
+            const Material* own = material.get();
+            obj_materials_.push_back(std::move(material));
+            pending_.push_back({&e,
+                                {},
+                                std::move(part_surface),
+                                [mesh = std::move(mesh), path](const Material& m, SurfaceDetail d) {
+                                    return std::make_unique<Mesh>(mesh, path, m, std::move(d));
+                                },
+                                own});
+        }
+        if (grey_line > 0) {
+            context_.warn_in(obj_path.string(), grey_line,
+                             "faces without a material from the file's mtllib are grey "
+                             "(diffuse 1, kd 0.8)");
+        }
+        if (dropped > 0) {
+            context_.warn(e, std::to_string(dropped) + (dropped == 1 ? " triangle" : " triangles") +
+                                 " of zero area in " + obj_path.string() + " dropped");
+        }
+        if (collapsed > 0) {
+            context_.warn(e, std::to_string(collapsed) +
+                                 (collapsed == 1 ? " triangle" : " triangles") + " in " +
+                                 obj_path.string() + " too thin for single precision dropped");
+        }
+    }
+
+    // The materials of an OBJ file's `mtllib` statements by name (the first definition of a
+    // name counts). A missing library is a warning at its `mtllib` line.
+    std::map<std::string, LibraryMaterial, std::less<>> read_material_libraries(
+        const ObjMesh& obj, const std::filesystem::path& obj_path) {
+        std::map<std::string, LibraryMaterial, std::less<>> library;
+        const std::filesystem::path folder = obj_path.parent_path();
+        for (const ObjReference& statement : obj.material_libraries) {
+            for (const std::filesystem::path& mtl_path : library_files(statement.name, folder)) {
+                std::vector<MtlMaterial> materials;
+                try {
+                    materials = read_mtl(mtl_path);
+                    files_read_.push_back(mtl_path);
+                } catch (const ObjOpenError& error) {
+                    context_.warn_in(obj_path.string(), statement.line,
+                                     "cannot open " + mtl_path.string() + ": " + error.what() +
+                                         "; its materials are grey");
+                    continue;
+                } catch (const MtlError& error) {
+                    throw SceneError(error.what());
+                }
+                for (MtlMaterial& m : materials) {
+                    warn_missing_images(m, mtl_path);
+                    const std::string name = m.name;
+                    library.try_emplace(name, LibraryMaterial{std::move(m), mtl_path});
+                }
+            }
+        }
+        return library;
+    }
+
+    // `mtllib` names one file whose name may hold spaces, or several separated by spaces: the
+    // whole name if such a file exists, else its words if each is a file, else the whole name
+    // (whose absence is then reported).
+    static std::vector<std::filesystem::path> library_files(std::string name,
+                                                            const std::filesystem::path& folder) {
+        std::ranges::replace(name, '\\', '/');
+        std::error_code error;
+        if (std::filesystem::is_regular_file(folder / name, error)) return {folder / name};
+        std::vector<std::filesystem::path> words;
+        std::size_t start = 0;
+        while ((start = name.find_first_not_of(" \t", start)) != std::string::npos) {
+            const std::size_t end = std::min(name.find_first_of(" \t", start), name.size());
+            words.push_back(folder / name.substr(start, end - start));
+            start = end;
+        }
+        const bool all_exist = std::ranges::all_of(words, [&](const std::filesystem::path& p) {
+            return std::filesystem::is_regular_file(p, error);
+        });
+        if (words.size() > 1 && all_exist) return words;
+        return {folder / name};
+    }
+
+    // Images of an MTL material: a missing one is warned about at its line and its constant
+    // colour stands; an alpha or bump map that exists is not applied yet, which is said too.
+    void warn_missing_images(const MtlMaterial& m, const std::filesystem::path& mtl_path) {
+        for (const auto* image : {&m.map_kd, &m.map_d, &m.bump}) {
+            if (!*image) continue;
+            const std::filesystem::path file = mtl_path.parent_path() / (*image)->path;
+            std::error_code error;
+            const bool exists = std::filesystem::is_regular_file(file, error);
+            if (exists && image == &m.map_kd) continue;
+            const std::string what = exists ? "alpha and bump maps of OBJ materials are not "
+                                              "applied yet"
+                                            : "cannot open " + file.string();
+            context_.warn_in(mtl_path.string(), (*image)->line,
+                             what + "; the material's constant colour is used");
+        }
+    }
+
+    // An MTL material's map_Kd through the scene's cache; null (the constant colour) when it has
+    // none, or one that cannot be read, which is a warning at its line.
+    std::shared_ptr<const MipMap> colour_map(const LibraryMaterial& m) {
+        if (!m.mtl.map_kd) return nullptr;
+        const std::filesystem::path file = m.mtl_path.parent_path() / m.mtl.map_kd->path;
+        std::error_code error;
+        if (!std::filesystem::is_regular_file(file, error)) return nullptr;  // warned already
+        const std::size_t before = textures_.files_read();
+        try {
+            auto image = textures_.get(file, TextureEncoding::kColor);
+            if (textures_.files_read() > before) files_read_.push_back(file);
+            return image;
+        } catch (const ImageError& e) {
+            context_.warn_in(m.mtl_path.string(), m.mtl.map_kd->line,
+                             std::string(e.what()) + "; the material's constant colour is used");
+            return nullptr;
+        }
+    }
+
+    static bool reads_uv(const SurfaceSpec& surface) { return surface.image || surface.height; }
+    // Texture coordinates no texture reads are not kept: a mesh stays as lean as without them.
+    static void drop_texcoords(ObjMesh& obj) {
+        obj.texcoords = {};
+        obj.texcoord_indices = {};
     }
 
     // The images a surface names, relative to the scene file's folder, through the scene's cache.
@@ -900,7 +1075,8 @@ class SceneReader {
 
     void resolve_objects() {
         for (const PendingObject& p : pending_) {
-            const Material* material = scene_.find_material(p.material);
+            const Material* material =
+                p.own_material ? p.own_material : scene_.find_material(p.material);
             if (!material) context_.fail(*p.element, unknown_material(p.material));
             scene_.objects.push_back(p.make(*material, p.surface.build(*material)));
         }
@@ -936,6 +1112,9 @@ class SceneReader {
         std::unique_ptr<Material> material;
     };
     std::vector<EmittingLight> emitting_lights_;
+    // The materials of meshes that take their OBJ file's own, kept apart from the scene's
+    // until every object is resolved, so that no scene name can refer to them.
+    std::vector<std::unique_ptr<Material>> obj_materials_;
     std::vector<std::filesystem::path> files_read_;
     TextureCache textures_;
 };

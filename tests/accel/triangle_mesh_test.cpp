@@ -259,3 +259,42 @@ TEST(TriangleMesh, TakesUnderEightyBytesPerTriangleWithItsHierarchy) {
 
 }  // namespace
 }  // namespace drt
+
+namespace drt {
+namespace {
+
+// Texture coordinates stay with their triangle when the hierarchy reorders the triangles.
+TEST(TriangleMeshTexcoords, FollowTheirTrianglesThroughTheHierarchysOrder) {
+    ObjMesh obj;
+    for (int i = 0; i < 200; ++i) {
+        const double x = (i * 37) % 200;
+        const auto base = static_cast<std::uint32_t>(obj.positions.size());
+        obj.positions.insert(obj.positions.end(), {{x, 0, 0}, {x + 1, 0, 0}, {x, 1, 0}});
+        obj.texcoords.push_back({x, 0.5});
+        for (std::uint32_t k = 0; k < 3; ++k) {
+            obj.position_indices.push_back(base + k);
+            obj.normal_indices.push_back(ObjMesh::kNoNormal);
+            // The middle corner has no vt: (0, 0).
+            obj.texcoord_indices.push_back(k == 1 ? ObjMesh::kNoTexcoord
+                                                  : static_cast<std::uint32_t>(i));
+        }
+    }
+    const TriangleMesh mesh(obj, MeshTransform{}, false, 1);
+    ASSERT_TRUE(mesh.has_texcoords());
+    ASSERT_EQ(mesh.triangle_count(), 200u);
+    for (std::uint32_t t = 0; t < 200; ++t) {
+        const auto [a, b, c] = mesh.corners(t);
+        const double x = a.x + mesh.origin().x;
+        const auto uv = mesh.corner_texcoords(t);
+        EXPECT_EQ(uv[0].x, x);
+        EXPECT_EQ(uv[0].y, 0.5);
+        EXPECT_EQ(uv[1].x, 0);
+        EXPECT_EQ(uv[1].y, 0);
+        EXPECT_EQ(uv[2].x, x);
+    }
+    obj.texcoord_indices.clear();
+    EXPECT_FALSE(TriangleMesh(obj, MeshTransform{}, false, 1).has_texcoords());
+}
+
+}  // namespace
+}  // namespace drt

@@ -157,3 +157,86 @@ TEST(ObjReader, FileSizePastTheLimitIsRefusedBeforeReading) {
 
 }  // namespace
 }  // namespace drt
+
+namespace drt {
+namespace {
+
+constexpr std::uint32_t kNoUv = ObjMesh::kNoTexcoord;
+
+TEST(ObjReaderUv, ReadsTextureCoordinatesPerCorner) {
+    const ObjMesh m = parse_obj(
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+        "f 1 2 3\n"  // before any vt: the corners have none
+        "vt 0.25 0.5\nvt 0.75\nvt 1 0 0\n"
+        "f 1/1 2/2 3/-1\n"
+        "f 1/3 3 4\n",
+        "m.obj");
+    ASSERT_EQ(m.texcoords.size(), 3u);
+    EXPECT_EQ(m.texcoords[0].x, 0.25);
+    EXPECT_EQ(m.texcoords[0].y, 0.5);
+    EXPECT_EQ(m.texcoords[1].x, 0.75);
+    EXPECT_EQ(m.texcoords[1].y, 0);  // v defaults to 0
+    EXPECT_EQ(m.texcoord_indices,
+              (std::vector<std::uint32_t>{kNoUv, kNoUv, kNoUv, 0, 1, 2, 2, kNoUv, kNoUv}));
+}
+
+TEST(ObjReaderUv, RejectsMalformedTextureCoordinates) {
+    const auto error = [](std::string_view text) {
+        try {
+            parse_obj(text, "m.obj");
+        } catch (const ObjError& e) {
+            return std::string(e.what());
+        }
+        return std::string("parsed");
+    };
+    EXPECT_EQ(error("v 0 0 0\nvt\n"), "m.obj:2: vt: 1 to 3 coordinates needed, got 0");
+    EXPECT_EQ(error("vt 1 2 3 4\n"), "m.obj:1: vt: more than 3 coordinates: \"4\"");
+    EXPECT_EQ(error("vt 0.5 x\n"), "m.obj:1: vt: \"x\" is not a number");
+    EXPECT_EQ(error("vt 0.5 inf\n"), "m.obj:1: vt: \"inf\" is not a finite number");
+    EXPECT_EQ(error("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n"),
+              "m.obj:5: f: texture index 2 is out of range; 1 defined above");
+}
+
+TEST(ObjReaderMaterials, ReadsLibrariesAndTheMaterialOfEachTriangle) {
+    const ObjMesh m = parse_obj(
+        "v 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\nv 0 1 0\r\n"
+        "g first\r\n"
+        "f 1 2 3\r\n"  // line 6: before any usemtl
+        "mtllib my materials.mtl\r\n"
+        "usemtl dark red\r\n"
+        "f 1 2 3 4\r\n"  // two triangles
+        "usemtl green  \r\n"
+        "f 1 3 4\r\n"
+        "usemtl dark red\r\n"
+        "f 2 3 4\r\n"
+        "mtllib sub\\more.mtl\n",
+        "m.obj");
+    ASSERT_EQ(m.material_libraries.size(), 2u);
+    EXPECT_EQ(m.material_libraries[0].name, "my materials.mtl");
+    EXPECT_EQ(m.material_libraries[0].line, 7);
+    EXPECT_EQ(m.material_libraries[1].name, "sub\\more.mtl");
+    ASSERT_EQ(m.material_names.size(), 2u);
+    EXPECT_EQ(m.material_names[0].name, "dark red");
+    EXPECT_EQ(m.material_names[0].line, 8);
+    EXPECT_EQ(m.material_names[1].name, "green");
+    EXPECT_EQ(m.material_names[1].line, 10);
+    const std::uint32_t none = ObjMesh::kNoMaterial;
+    EXPECT_EQ(m.triangle_materials, (std::vector<std::uint32_t>{none, 0, 0, 1, 0}));
+    EXPECT_EQ(m.first_face_without_material, 6);
+    EXPECT_EQ(m.triangle_count(), 5u);
+}
+
+TEST(ObjReaderUv, TheFirstFaceMayNameTextureCoordinates) {
+    const ObjMesh m = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5 0.5\nf 1/1 2 3/1\n", "m.obj");
+    EXPECT_EQ(m.texcoord_indices, (std::vector<std::uint32_t>{0, kNoUv, 0}));
+}
+
+TEST(ObjReaderMaterials, AFileWithoutUsemtlKeepsNoPerTriangleMaterials) {
+    const ObjMesh m = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "m.obj");
+    EXPECT_TRUE(m.triangle_materials.empty());
+    EXPECT_TRUE(m.texcoord_indices.empty());
+    EXPECT_EQ(m.first_face_without_material, 4);
+}
+
+}  // namespace
+}  // namespace drt

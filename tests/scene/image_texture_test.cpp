@@ -215,9 +215,11 @@ TEST_F(ImageTextureScene, MissingCorruptAndHostileImagesAreErrorsAtTheirLine) {
 
     EXPECT_NE(load_error(plane + "/>").find("missing required attribute 'TextureFile'"),
               std::string::npos);
-    EXPECT_NE(load_error("<Mesh File=\"m.obj\" Material=\"M\" BumpFile=\"t.png\"/>")
-                  .find("not supported yet"),
-              std::string::npos);
+    // A Mesh reads its images as every surface does: a missing one is an error naming it.
+    const std::string mesh =
+        load_error("<Mesh File=\"m.obj\" Material=\"M\" BumpFile=\"nope.png\"/>");
+    EXPECT_NE(mesh.find("Mesh: "), std::string::npos) << mesh;
+    EXPECT_NE(mesh.find("nope.png"), std::string::npos) << mesh;
 }
 
 // A rendered check of the whole path: a wall (normal +z) seen from +z through one copy of an

@@ -1037,8 +1037,6 @@ TEST_F(SceneFile, MeshErrors) {
         (dir_ / "bad.obj").string() + ":4: f: vertex index 4 is out of range; 3 defined above");
     EXPECT_EQ(error_of_mesh("Material=\"Gray\""),
               s + ":2: Mesh: missing required attribute 'File'");
-    EXPECT_EQ(error_of_mesh("File=\"tet.obj\""),
-              s + ":2: Mesh: missing required attribute 'Material'");
     EXPECT_EQ(error_of_mesh("File=\"tet.obj\" Material=\"Gray\" Scale=\"0\""),
               s + ":2: Mesh: Scale must be positive, got 0");
     EXPECT_EQ(error_of_mesh("File=\"tet.obj\" Material=\"Gray\" Scale=\"-2\""),

@@ -31,7 +31,8 @@ class Mesh final : public Object {
 
   protected:
     SurfaceCoordinates locate(const Ray& ray, const Hit& hit, SurfaceHit& surface) const override;
-    // A triangle's own (u, v): the barycentrics (b1, b2) of the hit.
+    // The file's `vt` interpolated over the hit triangle where the mesh kept them, else the
+    // triangle's own (u, v): the barycentrics (b1, b2) of the hit.
     SurfaceUv surface_uv(const Ray& ray, const Hit& hit, const SurfaceHit& surface) const override;
 
   private:

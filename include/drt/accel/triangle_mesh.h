@@ -72,6 +72,13 @@ class TriangleMesh {
     // way relative to the geometric normal.
     Vec3 shading_normal(std::uint32_t triangle, const Barycentrics& b) const;
     bool smooth() const { return !normals_.empty(); }
+    // Whether the file gave texture coordinates (`vt`); only then are they kept.
+    bool has_texcoords() const { return !texcoords_.empty(); }
+    // The (u, v) of a triangle's corners: the file's `vt`, (0, 0) for a corner without one.
+    std::array<Vec2, 3> corner_texcoords(std::uint32_t triangle) const {
+        const auto& t = texcoords_[triangle];
+        return {Vec2{t[0], t[1]}, Vec2{t[2], t[3]}, Vec2{t[4], t[5]}};
+    }
     // For a smooth mesh, the point at `b` moved out onto the curved surface that the vertex
     // normals describe (SurfaceHit::light_point in object.h).
     Vec3 lifted(std::uint32_t triangle, const Barycentrics& b) const;
@@ -107,6 +114,8 @@ class TriangleMesh {
     std::vector<Float3> positions_;  // relative to origin_
     std::vector<Float3> normals_;    // per vertex, unit; empty for a flat mesh
     std::vector<std::array<std::uint32_t, 3>> triangles_;  // in leaf order
+    // Per triangle, its corners' (u, v) in single precision; empty when the file has no `vt`.
+    std::vector<std::array<float, 6>> texcoords_;
     MeshTree tree_;
     std::size_t dropped_ = 0;
     std::size_t collapsed_ = 0;

@@ -2,6 +2,8 @@
 // translates them): a uniform scale, then rotations about x, y and z in that order.
 #pragma once
 
+#include <optional>
+
 #include "drt/util/math.h"
 
 namespace drt {
@@ -11,6 +13,10 @@ namespace drt {
 struct MeshTransform {
     double scale = 1;
     Vec3 rotate_degrees;
+    // Where the mesh keeps the origin of its own (single-precision) coordinates, in transformed
+    // coordinates; none: the centre of its bounds. Parts of one file given the same origin round
+    // their shared vertices alike, so no crack opens between them.
+    std::optional<Vec3> origin = std::nullopt;
 
     Vec3 apply(const Vec3& v) const;
     // The same rotation for a direction (a uniform positive scale leaves directions alone).

@@ -1,7 +1,8 @@
-// Reads the subset of Wavefront OBJ that docs/scene-format.md ("Meshes") defines: `v`, `vn` and `f`
-// (polygons split into fans), indices in the forms v, v/vt, v//vn and v/vt/vn, positive or negative
-// (relative). Every other statement is ignored. A malformed number or index is an error naming the
-// file and line, never a silent zero.
+// Reads the subset of Wavefront OBJ that docs/scene-format.md ("Meshes", "OBJ materials") defines:
+// `v`, `vn`, `vt`, `f` (polygons split into fans), indices in the forms v, v/vt, v//vn and v/vt/vn,
+// positive or negative (relative), and the material statements `mtllib` and `usemtl`. Every other
+// statement is ignored. A malformed number or index is an error naming the file and line, never a
+// silent zero.
 #pragma once
 
 #include <cstdint>
@@ -28,8 +29,16 @@ class ObjOpenError : public std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
+// A statement's argument and the line it stands on, for messages about it.
+struct ObjReference {
+    std::string name;  // the rest of the line, trimmed: names may hold spaces
+    int line = 0;
+};
+
 struct ObjMesh {
     static constexpr std::uint32_t kNoNormal = UINT32_MAX;
+    static constexpr std::uint32_t kNoTexcoord = UINT32_MAX;
+    static constexpr std::uint32_t kNoMaterial = UINT32_MAX;
 
     std::vector<Vec3> positions;  // the `v` statements, in order
     std::vector<Vec3> normals;    // the `vn` statements, as written (not normalised)
@@ -37,6 +46,17 @@ struct ObjMesh {
     // triangles (0, i, i + 1). Indices are 0-based.
     std::vector<std::uint32_t> position_indices;
     std::vector<std::uint32_t> normal_indices;  // parallel to position_indices; kNoNormal if none
+    std::vector<Vec2> texcoords;                // the `vt` statements' (u, v), in order
+    // Parallel to position_indices once any corner has a `vt` (empty before): kNoTexcoord if none.
+    std::vector<std::uint32_t> texcoord_indices;
+
+    std::vector<ObjReference> material_libraries;  // the `mtllib` statements, in order
+    // The names that `usemtl` selects, each once, at the line of its first `usemtl`.
+    std::vector<ObjReference> material_names;
+    // Per triangle, the index into material_names of the material in force, or kNoMaterial
+    // before the first `usemtl`. Empty when the file has no `usemtl`.
+    std::vector<std::uint32_t> triangle_materials;
+    int first_face_without_material = 0;  // its line, or 0 if every face follows a `usemtl`
 
     std::size_t triangle_count() const { return position_indices.size() / 3; }
 };

@@ -1,0 +1,153 @@
+// A Mesh without a Material attribute, rendered: each face shows its own MTL material.
+#include <gtest/gtest.h>
+#include <stb_image_write.h>
+
+#include <array>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "drt/render/renderer.h"
+#include "drt/scene/scene_loader.h"
+#include "temp_folder.h"
+
+namespace drt {
+namespace {
+
+class ObjMaterialsRender : public test::TempFolderTest {
+  protected:
+    void write(const std::string& name, std::string_view contents) const {
+        std::ofstream(dir_ / name, std::ios::binary)
+            .write(contents.data(), static_cast<std::streamsize>(contents.size()));
+    }
+};
+
+// Two unit-height quads side by side at z = 0, seen head-on under white ambient light alone, so
+// that a pixel shows its face's kd exactly.
+TEST_F(ObjMaterialsRender, EachFaceShowsItsMaterialsColour) {
+    write("m.obj",
+          "v -2 -1 0\nv 0 -1 0\nv 0 1 0\nv -2 1 0\nv 2 -1 0\nv 2 1 0\n"
+          "mtllib m.mtl\nusemtl left\nf 1 2 3 4\nusemtl right\nf 2 5 6 3\n");
+    write("m.mtl", "newmtl left\nKd 0.9 0.1 0.1\nnewmtl right\nKd 0.1 0.9 0.1\n");
+    write("s.xml",
+          "<Scene><Image Width=\"8\" Height=\"4\"/><Render Samples=\"1\"/>\n"
+          "<Ambient r=\"1\" g=\"1\" b=\"1\"/>\n"
+          "<Camera Ex=\"0\" Ey=\"0\" Ez=\"5\" Lx=\"0\" Ly=\"0\" Lz=\"0\" Fov=\"30\"/>\n"
+          "<Mesh File=\"m.obj\" Smooth=\"0\"/></Scene>\n");
+    const LoadedScene loaded = load_scene(dir_ / "s.xml");
+    RenderOptions options;
+    options.threads = 1;
+    const Image image = render(loaded.scene, options).image;
+    // Pixel columns 1 and 6 look at x = ±1.67 on the quads; which one is on the image's left
+    // follows the camera's convention, so only the pair is asserted, and that they differ.
+    for (const int y : {1, 2}) {
+        const Color a = image.at(1, y), b = image.at(6, y);
+        const Color& red = a.r > b.r ? a : b;
+        const Color& green = a.r > b.r ? b : a;
+        EXPECT_NEAR(red.r, 0.9, 1e-6);
+        EXPECT_NEAR(red.g, 0.1, 1e-6);
+        EXPECT_NEAR(red.b, 0.1, 1e-6);
+        EXPECT_NEAR(green.r, 0.1, 1e-6);
+        EXPECT_NEAR(green.g, 0.9, 1e-6);
+        EXPECT_NEAR(green.b, 0.1, 1e-6);
+    }
+}
+
+// A 16 x 16 image in four 8 x 8 blocks, top rows first as images are stored: blue, white over
+// red, green. (0, 0) is the bottom-left corner, so red is around (u, v) = (0.25, 0.25) and blue
+// around (0.25, 0.75). Blocks rather than single texels: a pixel's sample lies anywhere in it,
+// and inside a block any filter reads the block's colour.
+void write_quadrants(const std::filesystem::path& path) {
+    constexpr int kSize = 16;
+    std::vector<unsigned char> rgb;
+    for (int y = 0; y < kSize; ++y) {
+        for (int x = 0; x < kSize; ++x) {
+            const bool top = y < kSize / 2, left = x < kSize / 2;
+            const std::array<unsigned char, 3> c =
+                top ? (left ? std::array<unsigned char, 3>{0, 0, 255}
+                            : std::array<unsigned char, 3>{255, 255, 255})
+                    : (left ? std::array<unsigned char, 3>{255, 0, 0}
+                            : std::array<unsigned char, 3>{0, 255, 0});
+            rgb.insert(rgb.end(), c.begin(), c.end());
+        }
+    }
+    ASSERT_TRUE(stbi_write_png(path.c_str(), kSize, kSize, 3, rgb.data(), 3 * kSize));
+}
+
+void expect_rgb(const Color& c, double r, double g, double b) {
+    EXPECT_NEAR(c.r, r, 0.01);
+    EXPECT_NEAR(c.g, g, 0.01);
+    EXPECT_NEAR(c.b, b, 0.01);
+}
+
+// A unit quad (x, y in [-1, 1]) whose corners' vt span [0, 1]^2, seen head-on: its four
+// quarters show the image's four texels, in the image's orientation, v upwards.
+void expect_quadrants(const Image& image) {
+    const Color top_left = image.at(2, 2), top_right = image.at(5, 2);
+    const Color bottom_left = image.at(2, 5), bottom_right = image.at(5, 5);
+    // Which side is u = 0 follows the camera's convention; up is v's direction either way.
+    const bool u_rises_rightwards = bottom_left.r > 0.5;
+    expect_rgb(u_rises_rightwards ? bottom_left : bottom_right, 1, 0, 0);
+    expect_rgb(u_rises_rightwards ? bottom_right : bottom_left, 0, 1, 0);
+    expect_rgb(u_rises_rightwards ? top_left : top_right, 0, 0, 1);
+    expect_rgb(u_rises_rightwards ? top_right : top_left, 1, 1, 1);
+}
+
+constexpr std::string_view kUvQuad =
+    "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
+    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n";
+
+std::string uv_scene(std::string_view mesh_attributes) {
+    return "<Scene><Image Width=\"8\" Height=\"8\"/><Render Samples=\"1\"/>\n"
+           "<Ambient r=\"1\" g=\"1\" b=\"1\"/><Materials><White diffuse=\"1\" kdr=\"1\" "
+           "kdg=\"1\" kdb=\"1\"/></Materials>\n"
+           "<Camera Ex=\"0\" Ey=\"0\" Ez=\"5\" Lx=\"0\" Ly=\"0\" Lz=\"0\" Fov=\"30\"/>\n"
+           "<Mesh File=\"m.obj\" Smooth=\"0\" " +
+           std::string(mesh_attributes) + "/></Scene>\n";
+}
+
+Image render_file(const std::filesystem::path& scene) {
+    RenderOptions options;
+    options.threads = 1;
+    return render(load_scene(scene).scene, options).image;
+}
+
+TEST_F(ObjMaterialsRender, AnImageTextureOnAMeshFollowsItsVt) {
+    write_quadrants(dir_ / "q.png");
+    write("m.obj", std::string(kUvQuad) + "f 1/1 2/2 3/3 4/4\n");
+    write("s.xml", uv_scene("Material=\"White\" EnableTexture=\"1\" Texture=\"image\" "
+                            "TextureFile=\"q.png\" TextureFilter=\"bilinear\""));
+    expect_quadrants(render_file(dir_ / "s.xml"));
+}
+
+TEST_F(ObjMaterialsRender, MapKdOfAnMtlMaterialIsItsColour) {
+    std::filesystem::create_directories(dir_ / "tex");
+    write_quadrants(dir_ / "tex" / "four texels.png");
+    write("m.obj", std::string(kUvQuad) + "mtllib m.mtl\nusemtl textured\nf 1/1 2/2 3/3 4/4\n");
+    write("m.mtl", "newmtl textured\nKd 1 1 1\nmap_Kd -s 1 1 1 tex\\four texels.png\n");
+    write("s.xml", uv_scene(""));
+    const LoadedScene loaded = load_scene(dir_ / "s.xml");
+    EXPECT_TRUE(loaded.warnings.empty()) << loaded.warnings.front();
+    expect_quadrants(render_file(dir_ / "s.xml"));
+}
+
+// Corners without vt are all at (0, 0): the repeating image's corner, where a bilinear lookup
+// averages the four blocks' texels there.
+TEST_F(ObjMaterialsRender, CornersWithoutVtAreAtTheOrigin) {
+    write_quadrants(dir_ / "q.png");
+    // A second quad without vt, nearer the camera, in front of the first.
+    write("m.obj", std::string(kUvQuad) +
+                       "v -1 -1 0.5\nv 1 -1 0.5\nv 1 1 0.5\nv -1 1 0.5\n"
+                       "f 1/1 2/2 3/3 4/4\nf 5 6 7 8\n");
+    write("s.xml", uv_scene("Material=\"White\" EnableTexture=\"1\" Texture=\"image\" "
+                            "TextureFile=\"q.png\" TextureFilter=\"bilinear\""));
+    const Image image = render_file(dir_ / "s.xml");
+    for (const int x : {2, 5}) {
+        for (const int y : {2, 5}) expect_rgb(image.at(x, y), 0.5, 0.5, 0.5);
+    }
+}
+
+}  // namespace
+}  // namespace drt
