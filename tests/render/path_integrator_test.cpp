@@ -400,6 +400,87 @@ TEST(PathIntegrator, GlossyOnlySceneHasTheDistributedIntegratorsMean) {
     expect_relative(path, distributed, 0.01, "glossy");
 }
 
+// Hard cases: none may give a NaN or an infinite pixel, and where a closed form exists the image
+// must still show it.
+int non_finite(const Image& image) {
+    int count = 0;
+    for (const float v : image.rgb) count += std::isfinite(v) ? 0 : 1;
+    return count;
+}
+
+std::string with_objects(std::string scene, const std::string& materials,
+                         const std::string& objects) {
+    scene.insert(scene.find("</Materials>"), materials);
+    scene.insert(scene.rfind("</Scene>"), objects);
+    return scene;
+}
+
+// Glass inside the emitting box: a lossless glass sphere (clear, and blurry with n 3) neither
+// makes nor takes light, so the furnace's value stays Le/(1 - rho) (MaxDepth 64 cuts 2^-65 of
+// it). Paths that enter the glass at grazing angles and bounce inside it are the risk.
+TEST(PathIntegratorHardCases, GlassInsideAnEmittingBoxKeepsTheFurnacesValue) {
+    for (const std::string n : {"1000", "3"}) {
+        const Scene scene = from_xml(with_objects(
+            emitting_box("path", 1, 64),
+            R"(<Glass diffuse="0" transmitt="1" ktr="1" ktg="1" ktb="1" index="1.5" n=")" + n +
+                R"("/>)",
+            R"(<Sphere Px="1" Py="0.5" Pz="3" Radius="1.5" Material="Glass"/>
+               <Sphere Px="-2" Py="-1" Pz="2" Radius="0.7" Material="Glass"/>)"));
+        const RenderResult r = render_with(scene);
+        EXPECT_EQ(non_finite(r.image), 0) << n;
+        EXPECT_NEAR(image_mean(r.image).g, 4.0, 0.02 * 4.0) << n;
+    }
+}
+
+// A camera skimming a broad glossy floor (n 1: lobes that reach below the surface and are
+// redrawn) and a glossy sphere seen at its rim, under an emitter and a sky.
+TEST(PathIntegratorHardCases, GrazingGlossyLobesStayFinite) {
+    const Scene scene = from_xml(R"(<Scene><Image Width="16" Height="16"/>
+      <Render Integrator="path" Samples="64" MaxDepth="16" Sampler="random"/>
+      <Background r="0.3" g="0.4" b="0.5"/>
+      <Camera Ex="0" Ey="0.001" Ez="-20" Lx="0" Ly="0" Lz="0" Fov="30"/>
+      <Materials><Floor diffuse="0.2" kdr="1" kdg="1" kdb="1" reflective="0.8" ksr="1" ksg="1" ksb="1" n="1"/>
+        <Metal reflective="1" ksr="1" ksg="1" ksb="1" n="2"/><Glow ker="50" keg="50" keb="50"/></Materials>
+      <Plane Px="0" Py="0" Pz="0" Vu="0" Vv="1" Vw="0" Material="Floor"/>
+      <Sphere Px="0" Py="1" Pz="0" Radius="1" Material="Metal"/>
+      <Sphere Px="3" Py="0.3" Pz="2" Radius="0.3" Material="Glow"/></Scene>)");
+    const RenderResult r = render_with(scene);
+    EXPECT_EQ(non_finite(r.image), 0);
+    EXPECT_GT(image_mean(r.image).r, 0);
+}
+
+// Emitters of radiance 1e6, a sphere and a triangle, small and bright enough to be fireflies: the
+// floor's closed form kd·Le·(r/h)² still holds, and nothing overflows.
+TEST(PathIntegratorHardCases, EmittersOfAMillionStayFiniteAndExact) {
+    const Scene scene = from_xml(R"(<Scene><Image Width="1" Height="1"/>
+      <Render Integrator="path" Samples="1024" ShadowRays="4" MaxDepth="6" Sampler="stratified"/>
+      <Camera Ex="30" Ey="4" Ez="0" Lx="0" Ly="0" Lz="0" Fov="0.001"/>
+      <Materials><Floor diffuse="1" kdr="0.5" kdg="0.5" kdb="0.5"/>
+        <Glow ker="1e6" keg="1e6" keb="1e6"/></Materials>
+      <Plane Px="0" Py="0" Pz="0" Vu="0" Vv="1" Vw="0" Material="Floor"/>
+      <Sphere Px="0" Py="10" Pz="0" Radius="0.01" Material="Glow"/></Scene>)");
+    const RenderResult r = render_with(scene);
+    EXPECT_EQ(non_finite(r.image), 0);
+    // Irradiance π·Le·(r/h)², one bounce off an infinite floor and nothing to return it.
+    EXPECT_NEAR(r.image.at(0, 0).r, 0.5 * 1e6 * 1e-6, 0.01 * 0.5);
+
+    const Scene box = from_xml(with_objects(
+        emitting_box("path", 1, 8), R"(<Bright ker="1e6" keg="1e6" keb="1e6"/>)",
+        R"(<Triangle Ax="0" Ay="4.9" Az="0" Bx="0.01" By="4.9" Bz="0" Cx="0" Cy="4.9" Cz="0.01" Material="Bright"/>
+           <Sphere Px="2" Py="-4" Pz="3" Radius="0.001" Material="Bright"/>)"));
+    EXPECT_EQ(non_finite(render_with(box).image), 0);
+}
+
+// MaxDepth 512 (the limit): in a furnace of albedo 1 roulette never ends a path, so every path
+// has 513 surface points, each adding Le.
+TEST(PathIntegratorHardCases, MaxDepthFiveHundredTwelveInALosslessFurnace) {
+    Scene scene = from_xml(furnace(1.0, 1.0, 512));
+    scene.settings.samples = 16;
+    const RenderResult r = render_with(scene);
+    EXPECT_EQ(non_finite(r.image), 0);
+    EXPECT_NEAR(image_mean(r.image).r, 513.0, 0.01 * 513);
+}
+
 TEST(PathIntegrator, ImageIsTheSameOnAnyNumberOfThreads) {
     for (const std::string sampler : {"stratified", "sobol"}) {
         Scene scene = testing::scaled_scene("gi/cornell-box.xml", 24, 4);
