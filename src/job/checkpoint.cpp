@@ -178,6 +178,8 @@ RenderIdentity identify_render(std::span<const fs::path> files, const RenderSett
             << settings.max_depth << " glossy_rays " << settings.glossy_rays << " seed "
             << settings.seed << " sampler " << settings.sampler << " pixel_plane_unit "
             << exact(settings.pixel_plane_unit);
+    // Only when set, so that checkpoints of renders without it keep their identity.
+    if (settings.clamp > 0) options << " clamp " << exact(settings.clamp);
     if (adaptive) {
         options << " noise_threshold " << exact(adaptive->noise_threshold) << " min_spp "
                 << adaptive->min_samples;

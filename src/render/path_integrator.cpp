@@ -96,6 +96,9 @@ void PathIntegrator::sample_pixel(int x, int y, const PixelSample& s, std::span<
             e.motion_blur ? sampler_.get_1d(sample, dim::kTime) * plan_.shutter_end : 0.0;
         ++counts.camera;
         out[i] = radiance(camera_.generate_ray(film[i], lens[i], time), sample, counts);
+        // The opt-in clamp (biased): the whole sample scaled, so that its colour is kept.
+        const double clamp = scene_.settings.clamp;
+        if (clamp > 0 && luminance(out[i]) > clamp) out[i] = out[i] * (clamp / luminance(out[i]));
     }
 }
 

@@ -394,6 +394,11 @@ class SceneReader {
                              "Ambient is ignored by the path integrator, which computes the "
                              "indirect light it stands for");
         }
+        if (const auto clamp = setting_lines_.find("Render");
+            clamp != setting_lines_.end() && scene_.settings.clamp > 0 &&
+            scene_.settings.integrator != IntegratorKind::kPath) {
+            context_.warn_at(clamp->second, "Clamp is used by the path integrator only");
+        }
         return {std::move(scene_), context_.take_warnings(), std::move(files_read_)};
     }
 
@@ -583,6 +588,8 @@ class SceneReader {
         s.sampler = in.text("Sampler", s.sampler);
         if (!make_sampler(s.sampler))
             in.fail("unknown sampler '" + abbreviated(s.sampler) + "'; known: " + sampler_list());
+        s.clamp = in.number("Clamp", 0);
+        in.check(s.clamp >= 0, "Clamp", "non-negative");
         const std::string integrator = in.text("Integrator", "distributed");
         if (integrator == "distributed") {
             s.integrator = IntegratorKind::kDistributed;

@@ -481,6 +481,36 @@ TEST(PathIntegratorHardCases, MaxDepthFiveHundredTwelveInALosslessFurnace) {
     EXPECT_NEAR(image_mean(r.image).r, 513.0, 0.01 * 513);
 }
 
+// The opt-in clamp: no camera sample's luminance exceeds it, so no pixel's does; the colour of a
+// clamped sample is kept; a clamp no sample reaches changes no bit.
+TEST(PathIntegrator, ClampBoundsEverySampleAndChangesNothingItDoesNotReach) {
+    const std::string xml =
+        with_objects(furnace(1.0, 0.5, 8), R"(<Hot ker="400000" keg="200000" keb="100000"/>)",
+                     R"(<Sphere Px="2" Py="3" Pz="6" Radius="0.05" Material="Hot"/>)");
+    const RenderResult plain = render_with(from_xml(xml));
+    float brightest = 0;
+    for (int y = 0; y < plain.image.height; ++y) {
+        for (int x = 0; x < plain.image.width; ++x) {
+            brightest = std::max(brightest, static_cast<float>(luminance(plain.image.at(x, y))));
+        }
+    }
+    ASSERT_GT(brightest, 3.0);  // the hot sphere's fireflies
+    const auto with_clamp = [&](const std::string& clamp) {
+        std::string clamped = xml;
+        clamped.insert(clamped.find("Integrator="), "Clamp=\"" + clamp + "\" ");
+        return render_with(from_xml(clamped));
+    };
+    const RenderResult clamped = with_clamp("3");
+    for (int y = 0; y < clamped.image.height; ++y) {
+        for (int x = 0; x < clamped.image.width; ++x) {
+            EXPECT_LE(luminance(clamped.image.at(x, y)), 3 + 1e-5);
+        }
+    }
+    // Biased: light is lost, never gained.
+    EXPECT_LT(luminance(image_mean(clamped.image)), luminance(image_mean(plain.image)));
+    EXPECT_EQ(with_clamp("1e30").image.rgb, plain.image.rgb);
+}
+
 TEST(PathIntegrator, ImageIsTheSameOnAnyNumberOfThreads) {
     for (const std::string sampler : {"stratified", "sobol"}) {
         Scene scene = testing::scaled_scene("gi/cornell-box.xml", 24, 4);

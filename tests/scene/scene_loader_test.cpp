@@ -1125,5 +1125,19 @@ TEST(SceneLoaderLightTransport, AmbientIsIgnoredByThePathIntegratorWithAWarningN
     EXPECT_TRUE(warnings_of(R"(<Ambient r="0.1"/>)").empty());
 }
 
+TEST(SceneLoaderLightTransport, ClampIsOffByDefaultNonNegativeAndForThePathIntegratorOnly) {
+    EXPECT_EQ(load(in_scene("")).scene.settings.clamp, 0);
+    EXPECT_EQ(load(in_scene(R"(<Render Integrator="path" Clamp="2.5"/>)")).scene.settings.clamp,
+              2.5);
+    EXPECT_EQ(body_error(R"(<Render Integrator="path" Clamp="-1"/>)"),
+              "t.xml:2: Render: Clamp must be non-negative, got -1");
+    EXPECT_EQ(body_error(R"(<Render Clamp="inf"/>)"),
+              "t.xml:2: Render: attribute 'Clamp' is not a number: \"inf\"");
+    const auto warnings = warnings_of(R"(<Render Clamp="3"/>)");
+    ASSERT_EQ(warnings.size(), 1u);
+    EXPECT_EQ(warnings[0], "t.xml:2: warning: Clamp is used by the path integrator only");
+    EXPECT_TRUE(warnings_of(R"(<Render Integrator="path" Clamp="3"/>)").empty());
+}
+
 }  // namespace
 }  // namespace drt

@@ -31,6 +31,9 @@ struct RenderSettings {
     std::uint64_t seed = 0;
     std::string sampler = "stratified";
     IntegratorKind integrator = IntegratorKind::kDistributed;
+    // The path integrator's opt-in clamp: a camera sample's radiance whose luminance exceeds it
+    // is scaled down to it (biased: it hides fireflies by losing light). 0: off.
+    double clamp = 0;
     // World units per pixel of the thesis's pixel-plane camera: 1 as the scene format defines
     // it; drt --scale changes it so a smaller or larger image keeps the same framing.
     double pixel_plane_unit = 1;
