@@ -15,6 +15,7 @@
 #
 # usage: tools/goal-study.sh [--drt BIN] [--scale S] [--targets E1,E2,..] [--work DIR]
 #                            [--repeat N] [--cpu C] [--scenes "test1 test2 .."] [--sampler S]
+# --scenes names thesis scenes (test1) or others by their path inside scenes/ (gi/cornell-box).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 drt=$root/build/drt
@@ -60,8 +61,13 @@ median() { tr ' ' '\n' | sort -g | awk '{v[NR] = $1} END {print (NR % 2) ? v[(NR
 csv=$work/goal-study.csv
 echo "scene,target,predicted_spp,predicted_s,goal_spp,goal_rounds,goal_s,goal_render_s,goal_estimated,goal_true,fixed_spp,fixed_s,fixed_render_s,fixed_true,load" >"$csv"
 for name in $scenes; do
-    scene=$root/scenes/thesis/$name.xml
-    ref=$work/$name-$scale-ref.pfm
+    # A thesis scene by its name (test1), any other by its path inside scenes/ (gi/cornell-box).
+    case $name in
+        */*) scene=$root/scenes/$name.xml ;;
+        *) scene=$root/scenes/thesis/$name.xml ;;
+    esac
+    key=${name//\//-}
+    ref=$work/$key-$scale-ref.pfm
     if [ ! -f "$ref" ]; then
         log "$name: reference (4096 spp, seed 1)"
         "$drt" "$scene" --scale "$scale" --spp 4096 --seed 1 -q -o "$ref"
@@ -69,7 +75,7 @@ for name in $scenes; do
     # rmse_at N: the true RMSE of --spp N (kept in the work folder: it is called in subshells,
     # and the images of --spp N are the same for every build that renders them bit-identically).
     rmse_at() {
-        local kept=$work/$name-$scale-$sampler.$1.rmse
+        local kept=$work/$key-$scale-$sampler.$1.rmse
         if [ ! -f "$kept" ]; then
             "$drt" "$scene" --scale "$scale" --sampler "$sampler" --spp "$1" -q -o "$tmp/fixed.pfm"
             "$drt" compare "$tmp/fixed.pfm" "$ref" | sed 's/rmse=\([^ ]*\).*/\1/' >"$kept"
