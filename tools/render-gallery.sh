@@ -30,7 +30,7 @@ declare -A caption=(
     [spot-marble]="Spot the cow (5 856 triangles) in marble on a checker floor, depth of field focused on the cow; a near and a far sphere blur."
     [moving-teapot]="A porcelain Utah teapot (6 320 triangles) sliding to the right while the shutter is open (motion blur of a mesh), beside a glossy copper teapot standing still."
     [cornell-box]="The Cornell box path traced: lit only by its ceiling lamp (an emitting quad), every other light indirect; the red and green walls bleed their colours onto the white boxes and the ceiling."
-    [test1-room]="Test1's room path traced (Integrator=\"path\", no Ambient): the same two thesis lights, now with the light that bounces off the walls; compare test1 above, the distributed original."
+    [test1-room]="Test1's room path traced (Integrator=\"path\", no Ambient): the same two thesis lights, now with the light that bounces off the walls (56 % of the image's light, docs/accuracy.md section 7), which makes the room far brighter (the thesis lights do not fall off with distance); compare test1 above, the distributed original."
     [glossy-mis]="Veach's plates: four glossy plates (n 5, 20, 80, 500) mirror four emitting spheres of equal power and growing size; the rough plates' reflections of the small bright spheres stay noisy, since glossy lobes are sampled by the scattered ray alone."
     [checker-teapot]="A checker-textured teapot under a red sphere whose soft shadow falls onto it, Spot in bump-mapped glossy gold, and a single Triangle as a glossy mirror behind them."
 )
