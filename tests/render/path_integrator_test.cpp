@@ -333,7 +333,7 @@ TEST(PathIntegrator, ShadowRaysScatteredRaysAndTheirWeighingAgree) {
 // Veach's plates (scenes/gi/glossy-mis.xml: four glossy plates with a dim diffuse part under four
 // emitting spheres of equal power, radius 0.05 to 1.35) rendered small by each strategy with the
 // same random numbers: the paths are then the same and only the weights of the emitted light
-// found at diffuse events differ. Shadow rays alone agree with the weighed estimate to 1e-7 of
+// found at diffuse events differ. Shadow rays alone agree with the weighed estimate to 1e-6 of
 // each band's mean (for a diffuse part the light sample's weight is nearly 1 here). The
 // scattered ray alone finds the two small spheres with probability about 1e-6 per diffuse event,
 // far too rarely for a test, so that comparison darkens them: measured over 8 seeds, every band
