@@ -3,7 +3,7 @@
 # Usage: tools/install-deps.sh [--study] [--bench] [extra-package ...]
 #   --study  also gnuplot-nox, which tools/accuracy-study.sh needs to draw its plots, and python3
 #            for tools/allocation-bound.py
-#   --bench  also libbenchmark-dev, povray, time, libembree-dev and blender, which bench/ needs
+#   --bench  also libbenchmark-dev, povray, time, libembree-dev, blender and python3, which bench/ needs
 #            (docs/performance.md)
 set -euo pipefail
 
