@@ -5,9 +5,11 @@
 # reference of its own (--ref-spp, another seed), then renders at each of --levels spp, drt then
 # Cycles, round after round on --threads threads; bench/cycles/analyse.py prints each one's
 # relative RMSE against its own reference and the time to reach 2 %, 1 % and 0.5 %, start-up
-# excluded (drt: --stats seconds; Cycles: its log, from the first sample to Finished) and
-# included (the process's wall clock), and the two references' agreement.
-# Usage: bench/cycles/race.sh [--scale F] [--levels "64 256 1024 4096"] [--ref-spp N]
+# included (the process's wall clock) and excluded (Cycles: its log, from the first sample to
+# Finished; drt: the wall clock less that of the same command at 1 spp, run each round: drt
+# runs without --stats, which would add its error estimate's renders, 30 % of the samples on
+# an image this small), and the two references' agreement.
+# Usage: bench/cycles/race.sh [--scale F] [--levels "64 256 1024 2048"] [--ref-spp N]
 #        [--rounds N] [--threads N] [--drt PATH] [--keep DIR]
 # The scenes render small (the Cornell box at 40 x 40, the room at 40 x 30: 0.5 % takes tens of
 # thousands of samples a pixel); --scale F multiplies those sizes (same framing). Needs blender
@@ -16,8 +18,8 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 drt=build/drt
 scale=1
-levels="64 256 1024 4096"
-ref_spp=16384
+levels="64 256 1024 2048"
+ref_spp=8192
 rounds=3
 threads=2
 keep=
@@ -46,13 +48,17 @@ since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.3f", b - a }'; }
 
 # One render each; appends a row to runs.tsv.
 render_drt() {  # scene name spp seed round scale
-    local image=$out/$2-drt-$3-s$4.pfm start
+    local image=$out/$2-drt-$3-s$4.pfm start wall startup=0
+    if [ "$5" != ref ]; then
+        start=$(now)
+        "$drt" "$1" --scale "$6" --spp 1 --threads "$threads" -q -o "$out/startup.pfm"
+        startup=$(since "$start")
+    fi
     start=$(now)
-    "$drt" "$1" --scale "$6" --spp "$3" --seed "$4" --threads "$threads" -q -o "$image" \
-        --stats "$out/stats.json"
-    local wall; wall=$(since "$start")
-    local seconds; seconds=$(sed -n 's/^ *"seconds": \([0-9.e+-]*\),.*/\1/p' "$out/stats.json")
-    printf '%s\tdrt\t%s\t%s\t%s\t%s\t%s\n' "$2" "$3" "$5" "$wall" "$seconds" "$image" >>"$runs"
+    "$drt" "$1" --scale "$6" --spp "$3" --seed "$4" --threads "$threads" -q -o "$image"
+    wall=$(since "$start")
+    printf '%s\tdrt\t%s\t%s\t%s\t%s\t%s\n' "$2" "$3" "$5" "$wall" \
+        "$(awk -v w="$wall" -v s="$startup" 'BEGIN { printf "%.3f", w - s }')" "$image" >>"$runs"
 }
 render_cycles() {  # scene name spp seed round scale
     local image=$out/$2-cycles-$3-s$4 start
