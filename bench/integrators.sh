@@ -3,7 +3,10 @@
 # scene rendered by both, in turn, round after round: Test1 (scenes/thesis/test1.xml, and the
 # same with Integrator="path"; its Ambient is then ignored) and the Cornell box
 # (scenes/gi/cornell-box.xml, and the same with the distributed integrator, where the lamp
-# lights the walls by shadow rays only). Rays per second from --stats (rays.total / seconds).
+# lights the walls by shadow rays only). Rays per CPU second (user + system, GNU time; one
+# thread by default: on a shared machine CPU time drifts less than wall-clock time): --stats'
+# rays.total over the CPU seconds less the share spent on the error estimate's extra samples
+# (estimate_cost, whose rays rays.total leaves out): seconds / (1 + estimate_cost).
 # Usage: bench/integrators.sh [--drt PATH] [--scale F] [--spp N] [--rounds N] [--threads N]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,7 +14,7 @@ drt=build/drt
 scale=0.25
 spp=16
 rounds=3
-threads=2
+threads=1
 while [ $# -gt 0 ]; do
     case "$1" in
         --drt) drt=$2; shift 2 ;;
@@ -34,19 +37,21 @@ echo "$(date -u '+%F %T') UTC, $(git rev-parse --short HEAD), load $(cut -d' ' -
 for round in $(seq "$rounds"); do
     for s in test1 cornell; do
         for i in distributed path; do
-            "$drt" "$out/$s-$i.xml" --scale "$scale" --spp "$spp" --threads "$threads" -q \
+            /usr/bin/time -f "%U %S" -o "$out/time" "$drt" "$out/$s-$i.xml" --scale "$scale" --spp "$spp" --threads "$threads" -q \
                 -o "$out/img.pfm" --stats "$out/stats.json" 2>/dev/null
-            tr -d '\n ' <"$out/stats.json" | sed 's/.*"seconds":\([^,]*\),.*"rays":{\([^}]*\)}.*/\1 \2/' |
+            { awk '{ printf "%.3f ", $1 + $2 }' "$out/time"; tr -d '\n ' <"$out/stats.json"; } |
+                sed 's/^\([0-9.]*\) .*"rays":{\([^}]*\)}.*"estimate_cost":\([^,}]*\).*/\1 \2 \3/' |
                 awk -v s="$s" -v i="$i" -v r="$round" '{
                     n = split($2, kv, ","); line = ""; total = 0
                     for (k = 1; k <= n; k++) { split(kv[k], p, ":"); gsub(/"/, "", p[1]); c[p[1]] = p[2] }
+                    $1 = $1 / (1 + $3)
                     printf "%s %s %s %.3f %.2f camera %d shadow %d diffuse %d reflection %d refraction %d\n",
                         r, s, i, $1, c["total"] / $1 / 1e6, c["camera"], c["shadow"], c["diffuse"] + 0,
                         c["reflection"], c["refraction"] }' | tee -a "$out/runs"
         done
     done
 done
-echo "round scene integrator seconds Mrays/s ... (above); medians:"
+echo "round scene integrator CPU-seconds-without-estimate Mrays/s ... (above); medians:"
 awk '{ k = $2 " " $3; v[k] = v[k] " " $5 }
      END { for (k in v) { n = split(substr(v[k], 2), a, " "); for (i = 2; i <= n; i++) for (j = i; j > 1 && a[j - 1] > a[j]; j--) { x = a[j]; a[j] = a[j - 1]; a[j - 1] = x }
                           m[k] = (n % 2) ? a[(n + 1) / 2] : (a[n / 2] + a[n / 2 + 1]) / 2

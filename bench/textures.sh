@@ -7,7 +7,8 @@
 # Spot and scenes/thesis/test1.xml at --scale 0.25, its procedural checker only). A point light and one
 # shadow ray keep the shading cheap, so the lookup's share shows; the cost per textured hit is
 # (textured - untextured) / the camera rays that hit Spot, counted from a render in which Spot
-# emits 1 and nothing else shows.
+# emits 1 and nothing else shows. Times are CPU seconds (user + system, GNU time) on one thread
+# by default: on a shared machine they drift less than wall-clock times.
 # Usage: bench/textures.sh [--drt PATH] [--base PATH] [--model OBJ] [--rounds N] [--threads N]
 #        [--spp N] [--keep DIR]
 set -euo pipefail
@@ -16,7 +17,7 @@ drt=build/drt
 base=
 model=/work/shared/models/spot.obj
 rounds=3
-threads=2
+threads=1
 spp=32
 keep=
 while [ $# -gt 0 ]; do
@@ -32,6 +33,7 @@ while [ $# -gt 0 ]; do
     esac
 done
 [ -x "$drt" ] || { echo "textures: no $drt; build first" >&2; exit 2; }
+[ -x /usr/bin/time ] || { echo "textures: needs GNU time: tools/install-deps.sh --bench" >&2; exit 2; }
 [ -f "$model" ] || { echo "textures: no model $model (--model OBJ with vt)" >&2; exit 2; }
 if [ -n "$keep" ]; then out=$(realpath -m "$keep"); mkdir -p "$out"; else out=$(mktemp -d); trap 'rm -rf "$out"' EXIT; fi
 drt=$(realpath "$drt")
@@ -101,16 +103,16 @@ for round in $(seq "$rounds"); do
         for s in plain marble image test1; do
             [ "${b%%=*}" = base ] && [ "$s" = marble -o "$s" = image ] && continue
             [ -z "$base" ] && [ "$s" = test1 ] && continue
-            "${b#*=}" "$out/$s.xml" --threads "$threads" -q -o "$out/$s.png" --stats "$out/stats.json" \
-                $([ "$s" = test1 ] && echo --scale 0.25)
-            seconds=$(sed -n 's/^ *"seconds": \([0-9.e+-]*\),.*/\1/p' "$out/stats.json")
+            /usr/bin/time -f "%U %S" -o "$out/time" "${b#*=}" "$out/$s.xml" --threads "$threads" -q \
+                -o "$out/$s.png" $([ "$s" = test1 ] && echo --scale 0.25)
+            seconds=$(awk '{ printf "%.2f", $1 + $2 }' "$out/time")
             line="$line ${b%%=*}/$s $seconds"
             echo "${b%%=*} $s $seconds" >>"$out/times"
         done
     done
     echo "$line"
 done
-awk -v hits="$hits" -v thr="$threads" '
+awk -v hits="$hits" '
     { t[$1 " " $2] = t[$1 " " $2] " " $3 }
     END {
         for (k in t) {
@@ -120,6 +122,6 @@ awk -v hits="$hits" -v thr="$threads" '
         }
         p = med["drt plain"]
         printf "marble / plain %.3f, image / plain %.3f, image / marble %.3f\n", med["drt marble"] / p, med["drt image"] / p, med["drt image"] / med["drt marble"]
-        printf "per textured camera hit (thread time: wall x threads): marble +%.0f ns, image +%.0f ns\n", 1e9 * thr * (med["drt marble"] - p) / hits, 1e9 * thr * (med["drt image"] - p) / hits
+        printf "per textured camera hit (CPU time): marble +%.0f ns, image +%.0f ns\n", 1e9 * (med["drt marble"] - p) / hits, 1e9 * (med["drt image"] - p) / hits
         if ("base plain" in med) printf "untextured: this build / base: Spot %.3f, Test1 %.3f\n", p / med["base plain"], med["drt test1"] / med["base test1"]
     }' "$out/times"
