@@ -21,10 +21,10 @@ by_key = defaultdict(list)
 images, refs = {}, {}
 for r in rows:
     if r["round"] == "ref":
-        refs[(r["scene"], r["renderer"])] = r["image"]
+        refs[(r["scene"], r["renderer"].split("-")[0])] = r["image"]
         continue
     key = (r["scene"], r["renderer"], int(r["spp"]))
-    by_key[key].append((float(r["wall"]), float(r["render"])))
+    by_key[key].append((float(r["wall"]), float(r["render"]), float(r["cpu"])))
     images[key] = r["image"]
 
 targets = (0.02, 0.01, 0.005)
@@ -44,11 +44,13 @@ for scene in scenes:
           f", all {pfm.mean(b) / pfm.mean(a):.4f}; relative RMSE between them "
           f"{pfm.relative_rmse(b, a):.4f}")
     curves = {}
-    for renderer in ("drt", "cycles"):
-        ref = ref_data[renderer]
+    renderers = [n for n in ("drt", "drt-sobol", "cycles")
+                 if any(k[:2] == (scene, n) for k in by_key)]
+    for renderer in renderers:
+        ref = ref_data[renderer.split("-")[0]]
         points = []
         print(f"{renderer}: spp, relative RMSE measured, corrected, wall s (median, range), "
-              "render s (median, range)")
+              "start-up excluded s (median, range), CPU s (median)")
         for spp in sorted(s for (sc, re, s) in by_key if sc == scene and re == renderer):
             _, _, img = pfm.read(images[(scene, renderer, spp)])
             measured = pfm.relative_rmse(img, ref)
@@ -56,10 +58,12 @@ for scene in scenes:
             times = by_key[(scene, renderer, spp)]
             wall = [t[0] for t in times]
             render = [t[1] for t in times]
-            points.append((spp, corrected, statistics.median(wall), statistics.median(render)))
+            cpu = [t[2] for t in times]
+            points.append((spp, corrected, statistics.median(wall), statistics.median(render),
+                           statistics.median(cpu)))
             print(f"  {spp:6d} {measured:.5f} {corrected:.5f}  {statistics.median(wall):8.3f} "
                   f"({min(wall):.3f}-{max(wall):.3f})  {statistics.median(render):8.3f} "
-                  f"({min(render):.3f}-{max(render):.3f})")
+                  f"({min(render):.3f}-{max(render):.3f})  {statistics.median(cpu):8.2f}")
         curves[renderer] = points
 
     def fit(points, column):
@@ -88,7 +92,7 @@ for scene in scenes:
         a, b = fit(points, column)
         return spp, a + b * spp, mark
 
-    for renderer in ("drt", "cycles"):
+    for renderer in renderers:
         pts = curves[renderer]
         slope = math.log(pts[-1][1] / pts[0][1]) / math.log(pts[-1][0] / pts[0][0])
         a_ex, b_ex = fit(pts, 3)
@@ -97,12 +101,21 @@ for scene in scenes:
               f"excluded, {a_in:.3f} s included; per 1000 spp {1000 * b_ex:.3f} s excluded, "
               f"{1000 * b_in:.3f} s included")
 
-    print("time to reach (s): target, drt spp, drt excluded, included; cycles spp, excluded, "
-          "included; cycles/drt excluded, included")
+    print("time to reach (s): target; per renderer spp, start-up excluded, included, CPU; "
+          "then Cycles' time / drt's (excluded, included, CPU)")
     for t in targets:
-        d_spp, d_ex, d_mark = reach(curves["drt"], t, 3)
-        _, d_in, _ = reach(curves["drt"], t, 2)
-        c_spp, c_ex, c_mark = reach(curves["cycles"], t, 3)
-        _, c_in, _ = reach(curves["cycles"], t, 2)
-        print(f"  {t * 100:.1f} %  drt {d_spp:7.0f}{d_mark}spp {d_ex:8.2f} {d_in:8.2f} | cycles "
-              f"{c_spp:7.0f}{c_mark}spp {c_ex:8.2f} {c_in:8.2f} | {c_ex / d_ex:5.2f}x {c_in / d_in:5.2f}x")
+        line = f"  {t * 100:.1f} %"
+        reached = {}
+        for renderer in renderers:
+            spp, ex, mark = reach(curves[renderer], t, 3)
+            _, inc, _ = reach(curves[renderer], t, 2)
+            _, cpu, _ = reach(curves[renderer], t, 4)
+            reached[renderer] = (ex, inc, cpu)
+            line += f" | {renderer} {spp:6.0f}{mark}spp {ex:7.2f} {inc:7.2f} {cpu:7.2f}"
+        print(line)
+        c = reached["cycles"]
+        for renderer in renderers[:-1]:
+            d = reached[renderer]
+            ratios = [f"{x / y:.2f}x" if y > 0 else "n/a" for x, y in zip(c, d)]
+            print(f"      cycles / {renderer}: {ratios[0]} excluded, {ratios[1]} included, "
+                  f"{ratios[2]} CPU")
