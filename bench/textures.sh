@@ -4,8 +4,8 @@
 # (generated: the model's own texture is not in the collection), rendered in turn round after
 # round by each binary given (--drt, and --base for a second build, e.g. main before image
 # textures, to show that an untextured scene's speed is unchanged: both render the untextured
-# Spot and scenes/thesis/test1.xml at --scale 0.25, its procedural checker only). A point light and one
-# shadow ray keep the shading cheap, so the lookup's share shows; the cost per textured hit is
+# Spot and scenes/thesis/test1.xml at --scale 0.25, its procedural checker only). A point
+# light and one shadow ray keep the shading cheap, so the lookup's share shows; the cost per textured hit is
 # (textured - untextured) / the camera rays that hit Spot, counted from a render in which Spot
 # emits 1 and nothing else shows. Times are CPU seconds (user + system, GNU time) on one thread
 # by default: on a shared machine they drift less than wall-clock times.

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The race with Blender's Cycles (issue 31): drt's path integrator (with its default stratified
-# sampler, and with --sampler sobol) and Cycles 3.4 on the Cornell
-# box (scenes/gi/cornell-box.xml) and the Test1 room (bench/cycles/test1-room.xml), each scene's
+# sampler, and with --sampler sobol) and Cycles 3.4 on the Cornell box
+# (scenes/gi/cornell-box.xml) and the Test1 room (bench/cycles/test1-room.xml), each scene's
 # Cycles twin built from the same XML by bench/cycles/twin.py. For each renderer: a converged
 # reference of its own (--ref-spp, another seed; drt's is rendered with the Sobol sampler, and
 # serves both drt runs), then renders at each of --levels spp, drt, drt-sobol, then Cycles,

@@ -1,8 +1,9 @@
-"""Builds the Blender Cycles twin of a drt scene and renders it: blender -b --python twin.py --
-SCENE.xml OUT.exr SPP [--scale F] [--seed S] [--pfm OUT.pfm]. Understands the subset of the scene format the
-Cycles race uses (path integrator; Triangle, Plane, Sphere; diffuse, transparent and emitting
-materials; the checker texture on planes; Falloff="1" lights; <Camera> or the thesis's
-pixel-plane camera) and refuses the rest, so that a twin is never silently different."""
+"""Builds the Blender Cycles twin of a drt scene and renders it:
+blender -b --python twin.py -- SCENE.xml OUT.exr SPP [--scale F] [--seed S] [--pfm OUT.pfm].
+Understands the subset of the scene format the Cycles race uses (path integrator; Triangle,
+Plane, Sphere; diffuse, transparent and emitting materials; the checker texture on floors;
+Falloff="1" lights; <Camera> or the thesis's pixel-plane camera) and refuses the rest, so that
+a twin is never silently different."""
 import math
 import sys
 import time
@@ -158,7 +159,6 @@ for m in root.find("Materials"):
         kd = rgb(m, "kd", 0.8)
         d.inputs["Color"].default_value = (*[diffuse * c for c in kd], 1)
         parts.append(d)
-        materials.setdefault("_diffuse", {})[m.tag] = (d, diffuse)
     if transmit > 0:
         # drt: transmitt * kt * [F L(reflected) + (1 - F) L(refracted)] with sigma = 1/n
         # radians around the ideal directions; Cycles' sharp Glass BSDF is the same with
@@ -176,7 +176,6 @@ for m in root.find("Materials"):
         e.inputs["Strength"].default_value = 1.0
         parts.append(e)
     if not parts:
-        parts.append(nodes.new("ShaderNodeBsdfTransparent"))
         fail(f"material {m.tag} is black")
     shader = parts[0]
     for p in parts[1:]:
@@ -222,7 +221,6 @@ def checker_material(base, o):
     odd = op("ABSOLUTE", op("MODULO", op("ADD", cx, cz), 2.0))
     mix = nodes.new("ShaderNodeMixRGB")
     links.new(odd, mix.inputs["Fac"])
-    mix.inputs["Color1"].default_value = (*[diffuse * c for c in rgb(o, "k2", 0.1)], 1)
     mix.inputs["Color1"].default_value = (*[diffuse * c for c in
                                             rgb(root.find("Materials").find(base), "kd", 0.8)], 1)
     mix.inputs["Color2"].default_value = (*[diffuse * c for c in rgb(o, "k2", 0.1)], 1)
@@ -231,7 +229,6 @@ def checker_material(base, o):
 
 
 triangles = {}  # material name -> list of corner triples
-mesh_objects = []
 
 
 def add_mesh(name, verts, faces, mat, smooth=False):
@@ -304,9 +301,9 @@ for i, l in enumerate(lights if lights is not None else []):
     intensity = rgb(l, "I", 1)
     peak = max(intensity)
     ld = bpy.data.lights.new(f"light{i}", "POINT")
-    # drt: a sphere of radius R and radiance I/R^2 (intensity pi I), a point light of I cos/r^2
-    # irradiance... in radiance units. Cycles 3.4: a point light of power P watts has radiant
-    # intensity P/(4 pi) and, with a radius r, shows a disc of radiance P/(4 pi^2 r^2).
+    # drt: a sphere of radius R and radiance I/R^2. Cycles 3.4: a point light of power P has
+    # radiant intensity P/(4 pi) and, with a radius r, shows a disc of radiance
+    # P/(4 pi^2 r^2); so P = 4 pi^2 I.
     ld.energy = 4 * math.pi ** 2 * peak
     ld.color = tuple(c / peak for c in intensity)
     ld.shadow_soft_size = radius
