@@ -72,6 +72,10 @@ RenderResult assembled(const RenderContext& context, const RenderRequest& reques
     result.stats.adaptive = request.applied_adaptive();
     if (request.adaptive) result.pixel_samples = sink.pixel_samples();
     result.stats.rays = sink.rays();
+    if (result.plan.effects.caustics) {
+        result.stats.photons =
+            std::uint64_t(context.scene().settings.photons->count) * std::uint64_t(request.samples);
+    }
     result.stats.samples = sink.samples();
     result.stats.pixels_converged = sink.converged();
     result.unfinished = sink.missing();
