@@ -211,6 +211,35 @@ void expect_profile(double H, double tolerance) {
     EXPECT_LT(worst, tolerance) << "floor " << H << " below the centre";
 }
 
+// A pixel's mean over its samples, pass by pass, converges to the model: near the focus, where
+// the first passes' wide radius blurs the steep profile most, the error of the rings' means
+// falls as passes are added.
+TEST(PhotonMap, CausticConvergesAsPassesAreAdded) {
+    constexpr double kBin = 0.05;
+    constexpr int kBins = 12;
+    const double H = 1.5;
+    Maps m(ball_scene(H, 5000, 0.1));
+    const Model model = ball_model(1, 1.5, H, kBin, kBins, 8);
+    const auto error_after = [&](std::uint32_t passes) {
+        double squares = 0;
+        for (int k = 2; k < kBins; ++k) {
+            const double r = (k + 0.5) * kBin;
+            double sum = 0;
+            for (std::uint32_t pass = 0; pass < passes; ++pass) {
+                const double phi = 2 * kPi * (pass * 0.618034);
+                sum +=
+                    m.maps.caustic(7, pass, {r * std::cos(phi), 0, r * std::sin(phi)}, {0, 1, 0}).r;
+            }
+            const double e = sum / passes - model.bins[k];
+            squares += e * e;
+        }
+        return std::sqrt(squares / (kBins - 2));
+    };
+    const double e4 = error_after(4), e32 = error_after(32), e256 = error_after(256);
+    EXPECT_LT(e32, 0.7 * e4);
+    EXPECT_LT(e256, 0.7 * e32);
+}
+
 TEST(PhotonMap, CausticProfileMatchesTheBallLensModel) {
     expect_profile(1.5, 0.1);
     expect_profile(3, 0.1);
@@ -258,6 +287,83 @@ TEST(PhotonMap, FocusIsParaxialWithTheBallLensSphericalAberration) {
     };
     EXPECT_GT(share(6, 7), 0.02);
     EXPECT_LT(share(7, 8), 1e-4);
+}
+
+}  // namespace
+}  // namespace drt
+
+namespace drt {
+namespace {
+
+// A floor lit by a sphere light of Falloff 1 through a clear pane (index 1, kt 1), seen from
+// between the pane and the floor. Shadow rays stop at the pane, so all the floor's light is
+// caustic: photons must bring exactly the light the floor gets without the pane, in both
+// integrators, and the path integrator must not count the light its own paths find through the
+// pane as well.
+std::string pane_scene(const std::string& integrator, bool pane, bool photons, int samples) {
+    return R"(<Scene><Image Width="8" Height="8"/>
+      <Render Samples=")" +
+           std::to_string(samples) + R"(" MaxDepth="4" Sampler="random" Integrator=")" +
+           integrator + R"("/>)" + (photons ? R"(<Photons Count="20000" Radius="0.2"/>)" : "") +
+           R"(<Camera Ex="0" Ey="1" Ez="0" Lx="0" Ly="0" Lz="0" Ux="0" Uy="0" Uz="1" Fov="90"/>
+      <Materials><Floor diffuse="1" kdr="0.5" kdg="0.5" kdb="0.5"/>
+        <Pane transmitt="1" ktr="1" ktg="1" ktb="1" index="1"/></Materials>
+      <Light Px="0.3" Py="2" Pz="0" Radius="0.25" Falloff="1" Ir="4" Ig="4" Ib="4"/>
+      <Plane Px="0" Py="0" Pz="0" Vu="0" Vv="1" Vw="0" Material="Floor"/>)" +
+           (pane ? R"(<Plane Px="0" Py="1.5" Pz="0" Vu="0" Vv="1" Vw="0" Material="Pane"/>)" : "") +
+           "</Scene>";
+}
+
+double mean_of(const std::string& xml, int threads = 2) {
+    RenderOptions options;
+    options.threads = threads;
+    const Image image = render(from_xml(xml), options).image;
+    double sum = 0;
+    for (int y = 0; y < image.height; ++y) {
+        for (int x = 0; x < image.width; ++x) sum += image.at(x, y).r;
+    }
+    return sum / (image.width * image.height);
+}
+
+TEST(PhotonMap, ClearPaneLetsPhotonsBringTheDirectLightInBothIntegrators) {
+    const double open = mean_of(pane_scene("distributed", false, false, 64));
+    EXPECT_GT(open, 0.1);
+    // Without photons the pane's shadow is black in the distributed integrator.
+    EXPECT_EQ(mean_of(pane_scene("distributed", true, false, 4)), 0.0);
+    EXPECT_NEAR(mean_of(pane_scene("distributed", true, true, 32)) / open, 1, 0.02);
+    // The path integrator's paths through the pane to the light are left to the photons: counted
+    // by both, the floor would be twice as bright.
+    const double path_open = mean_of(pane_scene("path", false, false, 64));
+    EXPECT_NEAR(path_open / open, 1, 0.02);
+    EXPECT_NEAR(mean_of(pane_scene("path", true, true, 32)) / open, 1, 0.02);
+}
+
+// Photons are traced only when the scene calls for them: a Falloff-1 light or an emitter, a
+// reflective or transparent surface, and a diffuse surface.
+TEST(PhotonMap, TracedOnlyWhenTheSceneCallsForThem) {
+    const std::string with = pane_scene("distributed", true, true, 2);
+    const RenderResult on = render(from_xml(with), RenderOptions{});
+    EXPECT_TRUE(on.plan.effects.caustics);
+    EXPECT_EQ(on.stats.photons, 2u * 20000u);
+    const auto off = [&](std::string xml, const std::string& from, const std::string& to) {
+        xml.replace(xml.find(from), from.size(), to);
+        const RenderResult r = render(from_xml(xml), RenderOptions{});
+        EXPECT_FALSE(r.plan.effects.caustics) << to;
+        EXPECT_EQ(r.stats.photons, 0u) << to;
+    };
+    off(with, R"(Falloff="1")", R"(Falloff="0")");  // the thesis's light has no power
+    off(with, R"(transmitt="1")", R"(transmitt="0" diffuse="1")");  // nothing focuses
+    off(with, R"(MaxDepth="4")", R"(MaxDepth="0")");  // no reflective or transparent event
+}
+
+TEST(PhotonMap, SameBitsOnAnyNumberOfThreads) {
+    const Scene scene = from_xml(pane_scene("path", true, true, 8));
+    RenderOptions one, three;
+    one.threads = 1;
+    three.threads = 3;
+    const Image a = render(scene, one).image, b = render(scene, three).image;
+    ASSERT_EQ(a.rgb.size(), b.rgb.size());
+    for (std::size_t i = 0; i < a.rgb.size(); ++i) ASSERT_EQ(a.rgb[i], b.rgb[i]);
 }
 
 }  // namespace
