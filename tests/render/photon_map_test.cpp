@@ -211,6 +211,29 @@ void expect_profile(double H, double tolerance) {
     EXPECT_LT(worst, tolerance) << "floor " << H << " below the centre";
 }
 
+// The estimate spreads each photon's power evenly over the disc of the pass's radius: summed
+// over a fine grid of gather points, it gives back the power of the photons stored there.
+TEST(PhotonMap, EstimateSpreadsEachPhotonOverItsDisc) {
+    Maps m(ball_scene(3, 20000, 0.1));
+    constexpr double kHalf = 3, kStep = 0.025;
+    for (const std::uint32_t pass : {0u, 5u}) {
+        const double radius = m.maps.pass(0, pass)->radius();
+        double stored = 0;
+        for (const Photon& p : m.maps.trace(0, pass)) {
+            if (std::abs(p.position[0]) < kHalf && std::abs(p.position[2]) < kHalf) {
+                stored += p.power[1];
+            }
+        }
+        double gathered = 0;
+        for (double x = -kHalf + kStep / 2; x < kHalf; x += kStep) {
+            for (double z = -kHalf + kStep / 2; z < kHalf; z += kStep) {
+                gathered += m.maps.caustic(0, pass, {x, 0, z}, {0, 1, 0}).g * kStep * kStep;
+            }
+        }
+        EXPECT_NEAR(gathered / stored, 1, 0.005) << "pass " << pass << ", radius " << radius;
+    }
+}
+
 // A pixel's mean over its samples, pass by pass, converges to the model: near the focus, where
 // the first passes' wide radius blurs the steep profile most, the error of the rings' means
 // falls as passes are added.
