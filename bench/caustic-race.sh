@@ -35,6 +35,9 @@ def read(path):
     fields, i = [], 2  # POV-Ray's 16-bit .ppm
     while len(fields) < 3:
         while d[i:i + 1].isspace(): i += 1
+        if d[i:i + 1] == b'#':  # a comment runs to the end of its line
+            i = d.index(b'\n', i)
+            continue
         j = i
         while not d[j:j + 1].isspace(): j += 1
         fields.append(int(d[i:j])); i = j

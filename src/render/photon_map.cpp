@@ -49,7 +49,8 @@ Vec3 perturbed(const Vec3& ideal, double sigma, double side, const Vec3& geometr
 }
 
 std::int64_t cell_of(double x, double cell) {
-    return static_cast<std::int64_t>(std::floor(x / cell));
+    // Clamped, so that a tiny radius far from the origin cannot overflow the conversion.
+    return static_cast<std::int64_t>(std::clamp(std::floor(x / cell), -1e18, 1e18));
 }
 
 }  // namespace
@@ -116,9 +117,9 @@ Color PhotonPass::estimate(const Vec3& point, const Vec3& normal) const {
     const std::int64_t x0 = cell_of(lo.x, cell_), x1 = cell_of(hi.x, cell_);
     const std::int64_t y0 = cell_of(lo.y, cell_), y1 = cell_of(hi.y, cell_);
     const std::int64_t z0 = cell_of(lo.z, cell_), z1 = cell_of(hi.z, cell_);
-    // At most 2 cells a side (they are 2r across); two cells may share a bucket, which is then
-    // read once.
-    std::array<std::size_t, 8> seen{};
+    // 2 cells a side (they are 2r across; 3 where rounding puts an end on a cell's border);
+    // two cells may share a bucket, which is then read once.
+    std::array<std::size_t, 27> seen{};
     std::size_t seen_count = 0;
     double sum[3] = {0, 0, 0};
     for (std::int64_t x = x0; x <= x1; ++x) {
