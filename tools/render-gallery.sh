@@ -29,6 +29,9 @@ declare -A caption=(
     [glass-bunny]="Test1's room with the glass sphere replaced by the Stanford bunny (69 451 triangles) in the thesis's Glass made glossy (n 200): blurry refraction, soft shadows of a mesh from two lights."
     [spot-marble]="Spot the cow (5 856 triangles) in marble on a checker floor, depth of field focused on the cow; a near and a far sphere blur."
     [moving-teapot]="A porcelain Utah teapot (6 320 triangles) sliding to the right while the shutter is open (motion blur of a mesh), beside a glossy copper teapot standing still."
+    [test1-caustic]="Test1's room with its second light made physical (Falloff 1, radius 10): the ideal aqua glass sphere focuses it into a caustic on the floor in front of it (photon maps, one pass per sample)."
+    [ring-cardioid]="A gold mirror ring (an open cylinder, ring.obj) under a low Falloff-1 point light: the light reflected off its inside gathers into a cardioid on the floor."
+    [glass-bunny-caustic]="The glass bunny in ideal aqua glass under Test1-caustic's Falloff-1 light: the bunny's caustic on the floor."
     [checker-teapot]="A checker-textured teapot under a red sphere whose soft shadow falls onto it, Spot in bump-mapped glossy gold, and a single Triangle as a glossy mirror behind them."
 )
 
@@ -38,7 +41,7 @@ body=$(mktemp)
 trap 'rm -f "$stats" "$body"' EXIT
 field() { sed -n "s/.*\"$1\": *\([0-9.e+-]*\).*/\1/p" "$stats" | head -n1; }
 
-for scene in scenes/thesis/*.xml scenes/figures/*.xml scenes/meshes/*.xml; do
+for scene in scenes/thesis/*.xml scenes/figures/*.xml scenes/meshes/*.xml scenes/caustics/*.xml; do
     name=$(basename "$scene" .xml)
     build/drt "$scene" -o "docs/images/$name.png" --stats "$stats" -q "$@"
     seconds=$(printf '%.1f' "$(field seconds)")
@@ -50,16 +53,18 @@ for scene in scenes/thesis/*.xml scenes/figures/*.xml scenes/meshes/*.xml; do
         echo
         echo "${caption[$name]:-}"
         echo
-        printf '`%s`: %sx%s, %s samples per pixel, %s shadow rays, %s s (%.1f million rays/s).\n\n' \
+        photons=$(field photons)
+        printf '`%s`: %sx%s, %s samples per pixel, %s shadow rays%s, %s s (%.1f million rays/s).\n\n' \
             "$scene" "$(field width)" "$(field height)" "$(field samples_per_pixel)" \
-            "$(field shadow_rays)" "$seconds" "$(field million_rays_per_second)"
+            "$(field shadow_rays)" "${photons:+, $photons photons}" "$seconds" \
+            "$(field million_rays_per_second)"
     } >>"$body"
 done
 
 {
     echo "# Gallery"
     echo
-    echo "Every thesis scene, single-effect figure and mesh scene of \`scenes/\`, rendered at its own settings"
+    echo "Every thesis scene, single-effect figure, mesh and caustic scene of \`scenes/\`, rendered at its own settings"
     echo "by \`tools/render-gallery.sh\` on $(nproc) cores of $(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n1) ($(date -u +%F), commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown))."
     echo "Times are wall-clock for the whole render on this machine (compare them only with times from the same processor); see docs/performance.md for"
     echo "side-by-side measurements. Scene details: [scenes/README.md](../scenes/README.md)."
