@@ -3,7 +3,7 @@
 # Usage: tools/install-deps.sh [--study] [--bench] [extra-package ...]
 #   --study  also gnuplot-nox, which tools/accuracy-study.sh needs to draw its plots, and python3
 #            for tools/allocation-bound.py
-#   --bench  also libbenchmark-dev, povray, time and libembree-dev, which bench/ needs
+#   --bench  also libbenchmark-dev, povray, time, libembree-dev, blender and python3, which bench/ needs
 #            (docs/performance.md)
 set -euo pipefail
 
@@ -16,7 +16,7 @@ packages=(g++ cmake make pkg-config libtinyxml2-dev libstb-dev libcli11-dev libo
 for arg in "$@"; do
     case "$arg" in
         --study) packages+=(gnuplot-nox python3) ;;
-        --bench) packages+=(libbenchmark-dev povray time libembree-dev) ;;
+        --bench) packages+=(libbenchmark-dev povray time libembree-dev blender python3) ;;
         *) packages+=("$arg") ;;
     esac
 done

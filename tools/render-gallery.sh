@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Renders every thesis scene, single-effect figure, mesh scene and path-traced scene (scenes/gi/)
-# at its own settings into docs/images/ and rewrites docs/gallery.md with each image, its settings
-# and its render time on this machine.
+# Renders every thesis scene, single-effect figure, mesh, caustic (scenes/caustics/) and path-traced
+# scene (scenes/gi/) at its own settings into docs/images/ and rewrites docs/gallery.md with each
+# image, its settings and its render time on this machine.
 # Usage: tools/render-gallery.sh [extra drt options, e.g. --threads 2]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -30,8 +30,11 @@ declare -A caption=(
     [spot-marble]="Spot the cow (5 856 triangles) in marble on a checker floor, depth of field focused on the cow; a near and a far sphere blur."
     [moving-teapot]="A porcelain Utah teapot (6 320 triangles) sliding to the right while the shutter is open (motion blur of a mesh), beside a glossy copper teapot standing still."
     [cornell-box]="The Cornell box path traced: lit only by its ceiling lamp (an emitting quad), every other light indirect; the red and green walls bleed their colours onto the white boxes and the ceiling."
-    [test1-room]="Test1's room path traced (Integrator=\"path\", no Ambient): the same two thesis lights, now with the light that bounces off the walls (56 % of the image's light, docs/accuracy.md section 7), which makes the room far brighter (the thesis lights do not fall off with distance); compare test1 above, the distributed original."
+    [test1-room]="Test1's room path traced (Integrator=\"path\", no Ambient): the same two thesis lights, now with the light that bounces off the walls (56 % of the image's light, docs/accuracy.md section 8), which makes the room far brighter (the thesis lights do not fall off with distance); compare test1 above, the distributed original."
     [glossy-mis]="Veach's plates: four glossy plates (n 5, 20, 80, 500) mirror four emitting spheres of equal power and growing size; the rough plates' reflections of the small bright spheres stay noisy, since glossy lobes are sampled by the scattered ray alone."
+    [test1-caustic]="Test1's room with its second light made physical (Falloff 1, radius 10): the ideal aqua glass sphere focuses it into a caustic on the floor in front of it (photon maps, one pass per sample)."
+    [ring-cardioid]="A gold mirror ring (an open cylinder, ring.obj) under a low Falloff-1 point light: the light reflected off its inside gathers into a cardioid on the floor."
+    [glass-bunny-caustic]="The glass bunny in ideal aqua glass under Test1-caustic's Falloff-1 light: the bunny's caustic on the floor."
     [checker-teapot]="A checker-textured teapot under a red sphere whose soft shadow falls onto it, Spot in bump-mapped glossy gold, and a single Triangle as a glossy mirror behind them."
 )
 
@@ -41,7 +44,7 @@ body=$(mktemp)
 trap 'rm -f "$stats" "$body"' EXIT
 field() { sed -n "s/.*\"$1\": *\([0-9.e+-]*\).*/\1/p" "$stats" | head -n1; }
 
-for scene in scenes/thesis/*.xml scenes/figures/*.xml scenes/meshes/*.xml scenes/gi/*.xml; do
+for scene in scenes/thesis/*.xml scenes/figures/*.xml scenes/meshes/*.xml scenes/caustics/*.xml scenes/gi/*.xml; do
     name=$(basename "$scene" .xml)
     build/drt "$scene" -o "docs/images/$name.png" --stats "$stats" -q "$@"
     seconds=$(printf '%.1f' "$(field seconds)")
@@ -53,16 +56,18 @@ for scene in scenes/thesis/*.xml scenes/figures/*.xml scenes/meshes/*.xml scenes
         echo
         echo "${caption[$name]:-}"
         echo
-        printf '`%s`: %sx%s, %s samples per pixel, %s shadow rays, %s s (%.1f million rays/s).\n\n' \
+        photons=$(field photons)
+        printf '`%s`: %sx%s, %s samples per pixel, %s shadow rays%s, %s s (%.1f million rays/s).\n\n' \
             "$scene" "$(field width)" "$(field height)" "$(field samples_per_pixel)" \
-            "$(field shadow_rays)" "$seconds" "$(field million_rays_per_second)"
+            "$(field shadow_rays)" "${photons:+, $photons photons}" "$seconds" \
+            "$(field million_rays_per_second)"
     } >>"$body"
 done
 
 {
     echo "# Gallery"
     echo
-    echo "Every thesis scene, single-effect figure, mesh scene and path-traced scene of \`scenes/\`, rendered at its own settings"
+    echo "Every thesis scene, single-effect figure, mesh, caustic and path-traced scene of \`scenes/\`, rendered at its own settings"
     echo "by \`tools/render-gallery.sh\` on $(nproc) cores of $(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n1) ($(date -u +%F), commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown))."
     echo "Times are wall-clock for the whole render on this machine (compare them only with times from the same processor); see docs/performance.md for"
     echo "side-by-side measurements. Scene details: [scenes/README.md](../scenes/README.md)."

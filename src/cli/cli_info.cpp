@@ -94,8 +94,14 @@ int info_command(int argc, const char* const* argv, std::ostream& out, std::ostr
         LoadedScene loaded = load_scene(scene_path);
         for (const std::string& w : loaded.warnings) err << w << "\n";
         overrides.apply(loaded.scene.settings);
-        out << describe(loaded.scene, plan_render(loaded.scene));
-        if (target) out << forecast_text(forecast(loaded.scene, *target, threads), *target);
+        const RenderPlan plan = plan_render(loaded.scene);
+        out << describe(loaded.scene, plan);
+        if (target && plan.effects.caustics) {
+            out << "no forecast for --target-error: caustics from photon maps are biased at every "
+                   "finite gather radius, and a render refuses the goal (docs/accuracy.md)\n";
+        } else if (target) {
+            out << forecast_text(forecast(loaded.scene, *target, threads), *target);
+        }
     } catch (const SceneError& e) {
         return report_failure(e, "drt info", printable(scene_path), err);
     } catch (const LimitError& e) {  // bad input only: a failure reaches run_cli's last guard

@@ -21,6 +21,7 @@
 #include "drt/job/mpi_work.h"
 #include "drt/job/render_job.h"
 #include "drt/render/error_estimate.h"
+#include "drt/render/render_plan.h"
 #include "drt/scene/render_limits.h"
 #include "drt/scene/scene_loader.h"
 #include "drt/util/atomic_file.h"
@@ -263,6 +264,15 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
         loaded.emplace(load_scene(scene_path));
         for (const std::string& w : loaded->warnings) err << w << "\n";
         job.overrides.apply(loaded->scene.settings);
+        // The error estimate measures noise; a photon-mapped caustic is also biased at every
+        // finite gather radius, so no goal can rest on it (docs/accuracy.md).
+        if (job.goal.wanted() && plan_render(loaded->scene).effects.caustics) {
+            throw LimitError(
+                std::string(job.goal.target_error ? "--target-error" : "--time-limit") +
+                " cannot be used with <Photons>: caustics from photon maps are "
+                "biased at every finite gather radius, which the error estimate "
+                "does not see; give Samples instead (docs/accuracy.md)");
+        }
         RenderSettings largest = loaded->scene.settings;
         if (job.goal.wanted() && !job.overrides.spp) largest.samples = kMaxSamples;
         if (const auto problem = render_limit_problem(largest, job.threads)) {
@@ -277,7 +287,9 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
     const Scene& scene = loaded->scene;
     RenderRequest request = RenderRequest::whole_image(scene.settings);
     request.adaptive = job.adaptive.settings();
-    request.estimate_error = job.estimate_shown || format_for_path(output) == ImageFormat::kExr;
+    // Photon-mapped caustics get no estimate (renderer.h): its second renders would be wasted.
+    request.estimate_error = (job.estimate_shown || format_for_path(output) == ImageFormat::kExr) &&
+                             !plan_render(scene).effects.caustics;
     RenderJobOptions options;
     options.threads = job.threads;
     options.checkpoint = checkpoint;

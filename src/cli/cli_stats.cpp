@@ -102,6 +102,7 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
       << json_number(r.stats.seconds > 0 ? rays.total() / r.stats.seconds / 1e6 : 0.0) << ",\n"
       << "  \"mean_spp\": " << json_number(double(r.stats.samples) / (double(s.width) * s.height))
       << ",\n";
+    if (s.photons) j << "  \"photons\": " << r.stats.photons << ",\n";
     const ErrorEstimate& error = r.stats.error;
     if (error.available()) {
         j << "  \"estimated_rmse\": " << json_number(*error.rmse)
@@ -124,6 +125,7 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
       << ", \"depth_of_field\": " << json_bool(e.depth_of_field)
       << ", \"motion_blur\": " << json_bool(e.motion_blur);
     if (path) j << ", \"indirect_light\": " << json_bool(e.indirect_light);
+    if (s.photons) j << ", \"caustics\": " << json_bool(e.caustics);
     j << "}\n}";
     return j.str();
 }

@@ -256,6 +256,7 @@ class Combination {
 
     void count(const RenderResult& r) {
         stats_.rays += r.stats.rays;
+        stats_.photons += r.stats.photons;
         stats_.samples += r.stats.samples;
         stats_.seconds += r.stats.seconds;
     }

@@ -63,8 +63,13 @@ Vec3 perturb_direction(const Vec3& ideal, double sigma, Vec2 u) {
 }
 
 Integrator::Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bvh,
-                       const Sampler& sampler)
-    : scene_(scene), plan_(plan), bvh_(bvh), sampler_(sampler), camera_(scene.camera()) {
+                       const Sampler& sampler, const PhotonMaps* photons)
+    : scene_(scene),
+      plan_(plan),
+      bvh_(bvh),
+      sampler_(sampler),
+      photons_(photons),
+      camera_(scene.camera()) {
     for (const auto& light : scene.lights) {
         any_visible_light_ = any_visible_light_ || light->visible();
         if (!light->is_point()) area_lights_.push_back(light.get());
@@ -122,8 +127,11 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
     Color result = m.emission;  // seen from either side
     if (m.has_diffuse()) {
         const Vec3 above = outside ? surface.light_normal : -surface.light_normal;
-        const Color light = scene_.ambient + direct_light(surface.light_point, above, shading,
-                                                          ray.time, s, depth, work.counts);
+        Color light = scene_.ambient + direct_light(surface.light_point, above, shading, ray.time,
+                                                    s, depth, work.counts);
+        // Light through glass and off mirrors: shadow rays never pass them, so it is counted
+        // here only.
+        if (photons_) light += photons_->caustic(s.seed, s.pass(), surface.point, geometric);
         result += m.diffuse * surface.kd * light;
     }
     if (depth >= scene_.settings.max_depth) return result;  // deeper rays would contribute black

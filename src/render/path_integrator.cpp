@@ -56,12 +56,13 @@ Vec3 cosine_direction(const Vec3& n, Vec2 u) {
 }  // namespace
 
 PathIntegrator::PathIntegrator(const Scene& scene, const RenderPlan& plan, const Bvh& bvh,
-                               const Sampler& sampler, Strategy strategy)
+                               const Sampler& sampler, Strategy strategy, const PhotonMaps* photons)
     : scene_(scene),
       plan_(plan),
       bvh_(bvh),
       sampler_(sampler),
       strategy_(strategy),
+      photons_(photons),
       camera_(scene.camera()) {
     for (const auto& light : scene.lights) {
         any_visible_light_ = any_visible_light_ || light->visible();
@@ -113,6 +114,7 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
     // by next-event estimation from `from`, and `scatter_density` is the density with which this
     // direction was chosen (the part's pick probability included).
     bool after_diffuse = false;
+    bool diffuse_seen = false;  // a diffuse event anywhere before
     Vec3 from;
     double scatter_density = 0;
     for (int depth = 0;; ++depth) {
@@ -153,7 +155,10 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
             double weight = 1;
             const auto emitter =
                 after_diffuse ? plan_.emitters.index_of(hit->object) : std::optional<std::size_t>{};
-            if (emitter && strategy_ == Strategy::kLightOnly) {
+            if (photons_ && diffuse_seen && !after_diffuse &&
+                plan_.emitters.index_of(hit->object)) {
+                weight = 0;  // diffuse, then only reflective or transparent events: a caustic
+            } else if (emitter && strategy_ == Strategy::kLightOnly) {
                 weight = 0;
             } else if (emitter && strategy_ == Strategy::kMis) {
                 const double light =
@@ -180,9 +185,10 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
 
         if (diffuse_weight > 0) {
             const Vec3 above = outside ? surface.light_normal : -surface.light_normal;
-            result += throughput * diffuse_colour *
-                      next_event(surface.light_point, above, shading, ray.time, s, depth,
-                                 diffuse_pick, counts);
+            Color light = next_event(surface.light_point, above, shading, ray.time, s, depth,
+                                     diffuse_pick, counts);
+            if (photons_) light += photons_->caustic(s.seed, s.pass(), surface.point, geometric);
+            result += throughput * diffuse_colour * light;
         }
 
         const double pick = sampler_.get_1d(s, path_dim::at(depth, path_dim::kLobe)) * total;
@@ -194,6 +200,7 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
             if (cosine == 0) return result;  // below the surface: no light comes from there
             throughput *= diffuse_colour / diffuse_pick;
             after_diffuse = true;
+            diffuse_seen = true;
             from = surface.light_point;
             scatter_density = diffuse_pick * cosine / kPi;
             ++counts.diffuse;

@@ -83,8 +83,11 @@ RenderContext::RenderContext(const Scene& scene)
       bvh_(scene.objects),
       area_plan_(plan_with(scene, true)),
       centre_plan_(plan_with(scene, false)),
-      area_integrator_(make_integrator(scene, area_plan_, bvh_, *sampler_)),
-      centre_integrator_(make_integrator(scene, centre_plan_, bvh_, *sampler_)),
+      photons_(area_plan_.effects.caustics
+                   ? std::make_unique<const PhotonMaps>(scene, area_plan_, bvh_)
+                   : nullptr),
+      area_integrator_(make_integrator(scene, area_plan_, bvh_, *sampler_, photons_.get())),
+      centre_integrator_(make_integrator(scene, centre_plan_, bvh_, *sampler_, photons_.get())),
       tiles_(tile_grid(scene.settings.width, scene.settings.height)) {}
 
 const RenderPlan& RenderContext::plan(const RenderRequest& request) const {
@@ -345,6 +348,7 @@ RenderContext::Pixel RenderContext::adaptive_pixel(const RenderRequest& request,
             s.path = path == 0 ? hash_of(0xada9717eULL, round) : hash_of(path, round);
         }
         s.index = extensible ? n : 0;
+        s.pass_base = extensible ? 0 : n;
         scratch.colors.resize(batch);
         integrator(request).sample_pixel(x, y, s, scratch.colors, rays);
         for (const Color& c : scratch.colors) {

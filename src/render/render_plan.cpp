@@ -5,6 +5,8 @@
 #include <numeric>
 #include <sstream>
 
+#include "drt/render/photon_map.h"
+
 namespace drt {
 
 namespace {
@@ -46,10 +48,11 @@ RenderPlan plan_render(const Scene& scene) {
     e.indirect_light = s.integrator == IntegratorKind::kPath;
     plan.emitters = Emitters(scene);
 
-    bool diffuse_used = false;
+    bool diffuse_used = false, focusing = false;
     for (const auto& object : scene.objects) {
         const Material& m = object->material();
         diffuse_used = diffuse_used || m.has_diffuse();
+        focusing = focusing || m.reflects() || m.transmits();
         if (s.max_depth > 0 && m.is_glossy()) {
             // Glass reflects part of the light too, so a glossy transparent material also
             // perturbs reflections.
@@ -68,6 +71,12 @@ RenderPlan plan_render(const Scene& scene) {
         plan.area_emitters.push_back(i);
     }
     e.soft_shadows = diffuse_used && !area_powers.empty();
+    bool photon_source = false;
+    for (std::size_t i = 0; i < plan.emitters.size(); ++i) {
+        photon_source = photon_source || (plan.emitters[i].kind != Emitters::Kind::kEnvironment &&
+                                          plan.emitters[i].power > 0);
+    }
+    e.caustics = s.photons && s.max_depth > 0 && diffuse_used && focusing && photon_source;
 
     const int area_count = static_cast<int>(area_powers.size());
     std::vector<int> area_rays;
@@ -169,6 +178,19 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
     if (e.motion_blur) out << " (shutter 0.." << plan.shutter_end << ")";
     out << "\n";
     if (path) out << "  indirect_light: " << flag(e.indirect_light) << "\n";
+    if (s.photons) {
+        out << "  caustics: " << flag(e.caustics);
+        if (e.caustics) {
+            const double radius =
+                s.photons->radius > 0 ? s.photons->radius : default_photon_radius(scene);
+            out << " (photon maps: " << s.photons->count
+                << " photons a pass, one pass a sample; first gather radius " << radius << ")";
+        } else {
+            out << " (<Photons> given, but no Falloff-1 light or emitter, reflective or "
+                   "transparent surface and diffuse surface together)";
+        }
+        out << "\n";
+    }
     return out.str();
 }
 

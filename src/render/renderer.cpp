@@ -72,11 +72,18 @@ RenderResult assembled(const RenderContext& context, const RenderRequest& reques
     result.stats.adaptive = request.applied_adaptive();
     if (request.adaptive) result.pixel_samples = sink.pixel_samples();
     result.stats.rays = sink.rays();
+    if (result.plan.effects.caustics) {
+        result.stats.photons =
+            std::uint64_t(context.scene().settings.photons->count) * std::uint64_t(request.samples);
+    }
     result.stats.samples = sink.samples();
     result.stats.pixels_converged = sink.converged();
     result.unfinished = sink.missing();
     result.spread = sink.spread();
-    if (result.unfinished.empty()) {
+    if (result.plan.effects.caustics) {
+        result.stats.error.unavailable =
+            "caustics from photon maps are biased at any finite gather radius: no estimate";
+    } else if (result.unfinished.empty()) {
         result.stats.error = estimate_error(
             result.image, result.spread, sink.error_sums(), sink.samples(), request.samples,
             context.spread_kind(request), context.rendered_pixels(request));

@@ -6,12 +6,18 @@
 
 namespace drt {
 
+std::uint64_t photon_bytes(const RenderSettings& settings) {
+    if (!settings.photons) return 0;
+    return std::uint64_t(std::max(settings.samples, 0)) *
+           std::uint64_t(std::max(settings.photons->count, 0)) * kBytesPerPhoton;
+}
+
 std::uint64_t estimated_render_bytes(const RenderSettings& settings, int threads) {
     const std::uint64_t pixels =
         std::uint64_t(std::max(settings.width, 0)) * std::uint64_t(std::max(settings.height, 0));
     const std::uint64_t samples = std::uint64_t(std::max(settings.samples, 0));
     return pixels * kBytesPerPixel +
-           std::uint64_t(std::max(threads, 1)) * samples * kBytesPerSample;
+           std::uint64_t(std::max(threads, 1)) * samples * kBytesPerSample + photon_bytes(settings);
 }
 
 std::optional<std::string> render_limit_problem(const RenderSettings& s, int threads) {
@@ -35,6 +41,13 @@ std::optional<std::string> render_limit_problem(const RenderSettings& s, int thr
     if (s.glossy_rays > kMaxRaysPerPoint)
         return over("glossy rays", s.glossy_rays, kMaxRaysPerPoint);
     if (s.max_depth > kMaxDepthLimit) return over("max depth", s.max_depth, kMaxDepthLimit);
+    if (const std::uint64_t photons = photon_bytes(s); photons > kMaxPhotonBytes) {
+        return "the photon maps need an estimated " + std::to_string(photons >> 20) + " MiB (" +
+               std::to_string(s.samples) + " passes x " + std::to_string(s.photons->count) +
+               " photons x " + std::to_string(kBytesPerPhoton) + " B), more than their " +
+               std::to_string(kMaxPhotonBytes >> 20) +
+               " MiB share of the budget: lower Samples or the Photons Count";
+    }
     const int workers = worker_threads(threads);
     const std::uint64_t bytes = estimated_render_bytes(s, workers);
     if (bytes > kMemoryBudget) {

@@ -91,7 +91,7 @@ std::optional<std::string_view> nearest(std::string_view name,
 constexpr std::string_view kElementNames[] = {
     "Scene",     "Image",    "Render",  "Background",  "Ambient", "Camera", "DepthOfField",
     "Materials", "Lights",   "Objects", "Light",       "Plane",   "Sphere", "MotionBlurPosition",
-    "Material",  "Triangle", "Mesh",    "Environment",
+    "Material",  "Triangle", "Mesh",    "Environment", "Photons",
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -521,6 +521,7 @@ class SceneReader {
             {"Background", &SceneReader::read_background, true},
             {"Ambient", &SceneReader::read_ambient, true},
             {"Environment", &SceneReader::read_environment, true},
+            {"Photons", &SceneReader::read_photons, true},
             {"Camera", &SceneReader::read_camera, true},
             {"DepthOfField", &SceneReader::read_depth_of_field, true},
             {"Materials", &SceneReader::read_materials},
@@ -599,6 +600,21 @@ class SceneReader {
             in.fail("unknown integrator '" + abbreviated(integrator) +
                     "'; known: distributed, path");
         }
+        in.warn_unknown();
+        warn_children(e);
+    }
+
+    void read_photons(const XMLElement& e) {
+        Attributes in(e, context_);
+        PhotonSettings p;
+        p.count = in.integer("Count", p.count);
+        in.check(p.count > 0, "Count", "positive");
+        in.check(p.count <= kMaxPhotonsPerPass, "Count", at_most(kMaxPhotonsPerPass));
+        if (const auto radius = in.optional_number("Radius")) {
+            in.check(*radius > 0, "Radius", "positive");
+            p.radius = *radius;
+        }
+        scene_.settings.photons = p;
         in.warn_unknown();
         warn_children(e);
     }

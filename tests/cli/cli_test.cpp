@@ -26,6 +26,7 @@
 #include "drt/io/image.h"
 #include "regex_match.h"
 #include "run_drt.h"
+#include "temp_folder.h"
 
 namespace drt {
 namespace {
@@ -1135,6 +1136,57 @@ TEST_F(CliTest, AllocationFailureInARenderFailsThatSceneOnly) {
     EXPECT_TRUE(regex_search(r.out, "\nbig\\.xml .* failed\nc\\.xml .* ok\n$")) << r.out;
 }
 #endif
+
+}  // namespace
+}  // namespace drt
+
+namespace drt {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace test;
+
+// A glass ball over a floor under a Falloff-1 light, with photons: 4 x 4 pixels, 2 samples.
+constexpr const char* kCausticScene = R"(<Scene><Image Width="4" Height="4"/>
+  <Render Samples="2"/><Photons Count="1000" Radius="0.1"/>
+  <Camera Ex="0" Ey="5" Ez="-5" Lx="0" Ly="0" Lz="0"/>
+  <Materials><Floor diffuse="1"/><Glass transmitt="1" index="1.5"/></Materials>
+  <Light Px="0" Py="100" Pz="0" Falloff="1" Ir="1e4" Ig="1e4" Ib="1e4"/>
+  <Plane Px="0" Py="0" Pz="0" Vu="0" Vv="1" Vw="0" Material="Floor"/>
+  <Sphere Px="0" Py="1.5" Pz="0" Radius="1" Material="Glass"/></Scene>)";
+
+class CliPhotons : public TempFolderTest {};
+
+TEST_F(CliPhotons, StatsCountPhotonsAndGoalsAreRefusedWithoutAnEstimate) {
+    write_bytes(dir_ / "c.xml", kCausticScene);
+    const Outcome r = run_drt({"c.xml", "-o", "c.pfm", "--stats", "s.json"}, dir_);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::string stats = read_bytes(dir_ / "s.json");
+    EXPECT_NE(stats.find("\"photons\": 2000,"), std::string::npos) << stats;
+    EXPECT_NE(stats.find("\"caustics\": true"), std::string::npos) << stats;
+    EXPECT_NE(stats.find("\"estimated_rmse\": null"), std::string::npos) << stats;
+    EXPECT_NE(r.err.find("estimated RMSE n/a"), std::string::npos) << r.err;
+    for (const std::string goal : {"--target-error", "--time-limit"}) {
+        const Outcome g = run_drt({"c.xml", "-o", "g.pfm", goal, "1"}, dir_);
+        EXPECT_EQ(g.status, 2);
+        EXPECT_EQ(g.err, "drt: c.xml: " + goal +
+                             " cannot be used with <Photons>: caustics from photon maps are biased "
+                             "at every finite gather radius, which the error estimate does not "
+                             "see; give Samples instead (docs/accuracy.md)\n");
+        EXPECT_FALSE(fs::exists(dir_ / "g.pfm"));
+    }
+    // Every pass's map is kept: Samples x Count x 48 B must fit a quarter of the budget.
+    const Outcome big = run_drt({"c.xml", "-o", "g.pfm", "--spp", "65536"}, dir_);
+    EXPECT_EQ(big.status, 2);
+    EXPECT_EQ(big.err,
+              "drt: c.xml: the photon maps need an estimated 3000 MiB (65536 passes x 1000 photons "
+              "x 48 B), more than their 1024 MiB share of the budget: lower Samples or the "
+              "Photons Count\n");
+    const Outcome info = run_drt({"info", "c.xml"}, dir_);
+    EXPECT_NE(info.out.find("caustics: sampled (photon maps: 1000 photons a pass"),
+              std::string::npos)
+        << info.out;
+}
 
 }  // namespace
 }  // namespace drt

@@ -1141,3 +1141,24 @@ TEST(SceneLoaderLightTransport, ClampIsOffByDefaultNonNegativeAndForThePathInteg
 
 }  // namespace
 }  // namespace drt
+
+namespace drt {
+namespace {
+
+TEST(SceneLoaderPhotons, CountAndRadiusAreCheckedWithTheirLine) {
+    EXPECT_EQ(body_error(R"(<Photons Count="0"/>)"),
+              "t.xml:2: Photons: Count must be positive, got 0");
+    EXPECT_EQ(body_error(R"(<Photons Count="20000000"/>)"),
+              "t.xml:2: Photons: Count must be at most 16777216, got 20000000");
+    EXPECT_EQ(body_error(R"(<Photons Radius="-1"/>)"),
+              "t.xml:2: Photons: Radius must be positive, got -1");
+    EXPECT_EQ(body_error(R"(<Photons Count="1.5"/>)").substr(0, 18), "t.xml:2: Photons: ");
+    const Scene defaults = load(in_scene("<Photons/>")).scene;
+    ASSERT_TRUE(defaults.settings.photons);
+    EXPECT_EQ(defaults.settings.photons->count, PhotonSettings::kDefaultCount);
+    EXPECT_EQ(defaults.settings.photons->radius, 0);  // drt's default, worked out per scene
+    EXPECT_FALSE(load(in_scene("")).scene.settings.photons);
+}
+
+}  // namespace
+}  // namespace drt

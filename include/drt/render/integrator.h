@@ -10,6 +10,7 @@
 
 #include "drt/accel/bvh.h"
 #include "drt/accel/occluders.h"
+#include "drt/render/photon_map.h"
 #include "drt/render/pixel_integrator.h"
 #include "drt/render/render_plan.h"
 #include "drt/sampling/sampler.h"
@@ -43,7 +44,9 @@ std::optional<Vec3> refract_below(const Vec3& d, const Vec3& shading, const Vec3
 
 class Integrator final : public PixelIntegrator {
   public:
-    Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bvh, const Sampler& sampler);
+    // With `photons`, diffuse parts add the caustic light the photon maps estimate.
+    Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bvh, const Sampler& sampler,
+               const PhotonMaps* photons = nullptr);
 
     // Camera samples s.index, s.index + 1, ... of pixel (x, y): the radiance along each camera
     // ray, into out. A run of a pixel's samples shares the work of drawing their camera points.
@@ -83,6 +86,7 @@ class Integrator final : public PixelIntegrator {
     const RenderPlan& plan_;
     const Bvh& bvh_;
     const Sampler& sampler_;
+    const PhotonMaps* photons_;
     Camera camera_;
     std::vector<const Light*> area_lights_;  // in scene order, as plan_.light_pick_cdf
     bool any_visible_light_ = false;

@@ -16,6 +16,7 @@
 #include <span>
 #include <vector>
 
+#include "drt/render/photon_map.h"
 #include "drt/render/pixel_integrator.h"
 #include "drt/scene/camera.h"
 
@@ -28,8 +29,12 @@ class PathIntegrator final : public PixelIntegrator {
     // same mean: tests compare them.
     enum class Strategy { kMis, kLightOnly, kScatterOnly };
 
+    // With `photons`, each diffuse event adds the caustic light the photon maps estimate, and an
+    // emitter that photons are traced from, reached after a diffuse event and only reflective
+    // or transparent events since, adds nothing: that light is the photons'.
     PathIntegrator(const Scene& scene, const RenderPlan& plan, const Bvh& bvh,
-                   const Sampler& sampler, Strategy strategy = Strategy::kMis);
+                   const Sampler& sampler, Strategy strategy = Strategy::kMis,
+                   const PhotonMaps* photons = nullptr);
 
     void sample_pixel(int x, int y, const PixelSample& s, std::span<Color> out,
                       RayCounts& counts) const override;
@@ -60,6 +65,7 @@ class PathIntegrator final : public PixelIntegrator {
     const Bvh& bvh_;
     const Sampler& sampler_;
     Strategy strategy_;
+    const PhotonMaps* photons_;
     Camera camera_;
     std::vector<const Light*> area_lights_;  // in scene order, as plan_.light_pick_cdf
     // For each emitter, the expected number of its shadow rays per diffuse event: what the

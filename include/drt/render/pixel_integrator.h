@@ -8,6 +8,7 @@
 #include <span>
 
 #include "drt/accel/bvh.h"
+#include "drt/render/photon_map.h"
 #include "drt/render/render_plan.h"
 #include "drt/sampling/sampler.h"
 #include "drt/scene/scene.h"
@@ -37,9 +38,10 @@ class PixelIntegrator {
                               RayCounts& counts) const = 0;
 };
 
-// The integrator scene.settings.integrator names, reading the plan, BVH and sampler it is given
-// (which must outlive it).
+// The integrator scene.settings.integrator names, reading the plan, BVH, sampler and photon maps
+// (null: no caustics) it is given, which must outlive it.
 std::unique_ptr<PixelIntegrator> make_integrator(const Scene& scene, const RenderPlan& plan,
-                                                 const Bvh& bvh, const Sampler& sampler);
+                                                 const Bvh& bvh, const Sampler& sampler,
+                                                 const PhotonMaps* photons = nullptr);
 
 }  // namespace drt

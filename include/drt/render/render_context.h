@@ -39,6 +39,9 @@ class RenderContext {
     // sample, a pixel block of at least 2, listed pixels inside the image, ascending, distinct.
     void check(const RenderRequest& request) const;
 
+    // Photons traced so far (0 without caustics).
+    std::uint64_t photons_traced() const { return photons_ ? photons_->traced() : 0; }
+
     // How the request's samples tell their error (error_estimate.h).
     SpreadKind spread_kind(const RenderRequest& request) const;
 
@@ -109,6 +112,8 @@ class RenderContext {
     Bvh bvh_;
     // For requests of more than one sample per pixel, and for those of one (pixel centres).
     RenderPlan area_plan_, centre_plan_;
+    // When the scene calls for caustics; the two plans trace the same photons.
+    std::unique_ptr<const PhotonMaps> photons_;
     // The integrator the scene names (make_integrator), over each plan.
     std::unique_ptr<const PixelIntegrator> area_integrator_, centre_integrator_;
     std::vector<Tile> tiles_;

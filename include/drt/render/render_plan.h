@@ -21,6 +21,9 @@ struct Effects {
     bool depth_of_field = false;     // a lens of non-zero radius
     bool motion_blur = false;        // a moving object
     bool indirect_light = false;     // the path integrator: light scattered by diffuse surfaces
+    // <Photons>, a photon source (a Falloff-1 light or an emitting sphere or mesh), a reflective
+    // or transparent surface to focus its light and a diffuse one to receive it (photon_map.h).
+    bool caustics = false;
 };
 
 struct RenderPlan {

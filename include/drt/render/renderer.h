@@ -48,6 +48,9 @@ struct RenderStats {
     std::uint64_t tile_messages = 0;
     double receive_seconds = 0, assemble_seconds = 0;
     RayCounts rays;
+    // Photons a render of the request traces: Count for each pass, one pass per camera sample
+    // index (photon_map.h), whichever process or thread traced them; 0 without caustics.
+    std::uint64_t photons = 0;
     std::uint64_t samples = 0;           // camera samples taken over all pixels
     std::uint64_t pixels_converged = 0;  // adaptive: pixels that stopped before the maximum
     // Adaptive sampling as applied, the minimum capped at the maximum; absent for a plain render.

@@ -26,7 +26,12 @@ struct PixelSample {
     // Which branch of the ray tree is asking (0 for the camera ray's first hit): rays spawned
     // side by side, such as the glossy rays of one hit, must not reuse each other's numbers.
     std::uint64_t path = 0;
+    // The pixel's camera sample this is, counted over the whole pixel, is pass_base + index: a
+    // renderer that starts a new pattern for more samples (index from 0 again) says where it
+    // continues. Photon maps are per such pass (photon_map.h); samplers do not read it.
+    std::uint32_t pass_base = 0;
 
+    std::uint32_t pass() const { return pass_base + index; }
     PixelSample branch(std::uint64_t kind, std::uint64_t j) const;
 };
 

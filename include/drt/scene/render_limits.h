@@ -10,6 +10,10 @@
 
 namespace drt {
 
+// The memory the photon maps of a render with these settings may take at most (none without
+// <Photons>): every pass's map, each photon stored at most once.
+std::uint64_t photon_bytes(const RenderSettings& settings);
+
 // The memory a render of these settings on `threads` worker threads needs at its peak.
 std::uint64_t estimated_render_bytes(const RenderSettings& settings, int threads);
 

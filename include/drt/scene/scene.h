@@ -21,6 +21,15 @@ namespace drt {
 // (docs/scene-format.md, "Light transport").
 enum class IntegratorKind { kDistributed, kPath };
 
+// <Photons>: caustics from photon maps (docs/scene-format.md, "Caustics: photon maps"). Each
+// progressive pass (one per camera sample index) traces `count` photons; the first pass gathers
+// within `radius`, 0 meaning drt's default (photon_map.h).
+struct PhotonSettings {
+    static constexpr int kDefaultCount = 10000;
+    int count = kDefaultCount;
+    double radius = 0;
+};
+
 struct RenderSettings {
     int width = 640;
     int height = 480;
@@ -37,6 +46,7 @@ struct RenderSettings {
     // World units per pixel of the thesis's pixel-plane camera: 1 as the scene format defines
     // it; drt --scale changes it so a smaller or larger image keeps the same framing.
     double pixel_plane_unit = 1;
+    std::optional<PhotonSettings> photons;  // absent: no <Photons>, no photons traced
 };
 
 // A point light with Falloff 1: it adds I·max(0, N·L)/r² to the thesis's sum of lights. (A sphere

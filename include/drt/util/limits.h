@@ -37,6 +37,14 @@ inline constexpr int kMaxRaysPerPoint = 65536;
 // within 8 MiB stacks with room to spare.
 inline constexpr int kMaxDepthLimit = 512;
 
+// Photon maps (<Photons>): every progressive pass keeps its own map for the whole render, one
+// pass per camera sample index, each photon stored at most once, at 48 bytes with its share of
+// the pass's hash grid. Samples × Count × 48 B may take at most a quarter of the budget; one
+// pass at most 2^24 photons (768 MiB).
+inline constexpr std::uint64_t kBytesPerPhoton = 48;
+inline constexpr std::uint64_t kMaxPhotonBytes = kMemoryBudget / 4;
+inline constexpr int kMaxPhotonsPerPass = 1 << 24;
+
 // Worker threads: more than the cores of any machine drt runs on, and each takes per-sample
 // memory (kBytesPerSample) of its own.
 inline constexpr int kMaxThreads = 1024;
