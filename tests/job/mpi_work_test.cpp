@@ -211,6 +211,25 @@ TEST_F(MpiCli, PathRenderIsTheSingleProcesssBitsAndDiffuseRays) {
     EXPECT_EQ(rays_of(dir_ / "mpi.json").find("\"diffuse\": 0,"), std::string::npos);
 }
 
+// Photon maps are functions of (seed, pass) alone, built by every process for itself: the caustic
+// is the single process's to the bit, and every process counts the photons it traced once.
+TEST_F(MpiCli, CausticRenderIsTheSingleProcesssBitsAndPhotons) {
+    const std::string caustic = (kSource / "scenes/caustics/test1-caustic.xml").string();
+    const std::vector<std::string> options{"--spp", "4", "-q"};
+    std::vector<std::string> plain = small(caustic, "plain.pfm", options);
+    plain.insert(plain.end(), {"--stats", "plain.json"});
+    ASSERT_EQ(run(plain).status, 0);
+    std::vector<std::string> args = small(caustic, "mpi.pfm", options);
+    args.insert(args.end(), {"--threads", "1", "--stats", "mpi.json"});
+    const Outcome r = run_mpi(3, args);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(bytes("mpi.pfm"), bytes("plain.pfm"));
+    EXPECT_EQ(rays_of(dir_ / "mpi.json"), rays_of(dir_ / "plain.json"));
+    const std::string stats = bytes("mpi.json");
+    EXPECT_NE(stats.find("\"photons\": 80000,"), std::string::npos) << stats;  // 4 passes of 20000
+    EXPECT_NE(stats.find("\"caustics\": true"), std::string::npos) << stats;
+}
+
 TEST_F(MpiCli, TargetErrorGivesTheSingleProcesssBits) {
     // Every round's count and weight is decided on the leader and shared, and so are a top-up
     // round's pixels: the same rounds as one process (here 8 spp and a top-up, combined).
