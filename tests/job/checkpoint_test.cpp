@@ -318,6 +318,29 @@ TEST_F(TempDir, APathRenderStoppedAndResumedGivesThePlainRendersBitsAndDiffuseRa
     EXPECT_EQ(r.render.stats.rays.total(), reference.stats.rays.total());
 }
 
+TEST_F(TempDir, ACausticRenderStoppedAndResumedGivesThePlainRendersBits) {
+    // The resumed run builds its photon maps anew: they are functions of (seed, pass) alone.
+    const fs::path caustic = kSource / "scenes/caustics/test1-caustic.xml";
+    const Scene scene = small_scene(caustic);
+    const RenderResult reference = plain(scene, std::nullopt);
+    ASSERT_GT(reference.stats.photons, 0u);
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
+    RenderJobOptions options;
+    options.threads = 1;
+    options.checkpoint = dir_ / "c.ckpt";
+    options.scene_files = {caustic};
+    options.stop_after_tiles = 3;
+    RenderJobResult r = run_render_job(scene, request, options);
+    ASSERT_FALSE(r.complete());
+    options.stop_after_tiles.reset();
+    options.threads = 2;
+    r = run_render_job(scene, request, options);
+    ASSERT_TRUE(r.complete());
+    EXPECT_EQ(r.resumed, 3u);
+    EXPECT_EQ(r.render.image.rgb, reference.image.rgb);
+    EXPECT_EQ(r.render.stats.rays.total(), reference.stats.rays.total());
+}
+
 // ---- the command line -------------------------------------------------------------------------
 
 class CheckpointCli : public TempDir {
