@@ -48,7 +48,8 @@ void open_checkpoint(const RenderContext& context, const RenderRequest& request,
     if (!options.checkpoint) return;
     const RenderSettings& settings = context.scene().settings;
     if (request.pixels != PixelChoice::kAll || request.paired ||
-        request.samples != settings.samples || request.seed != settings.seed) {
+        request.samples != settings.samples || request.seed != settings.seed ||
+        !request.aovs.empty()) {
         throw std::invalid_argument("a checkpoint of a request other than the scene's image");
     }
     std::string refused;
@@ -115,7 +116,10 @@ RenderJobResult run_job(const RenderContext& context, const RenderRequest& asked
 
     // Only the leader assembles the image and keeps the checkpoint.
     std::optional<ImageSink> image;
-    if (leader) image.emplace(scene.settings.width, scene.settings.height, context.tiles());
+    if (leader) {
+        image.emplace(scene.settings.width, scene.settings.height, context.tiles(),
+                      aov_channel_count(request.aovs));
+    }
     std::optional<CheckpointSink> kept;
     open_checkpoint(context, request, options, leader, image ? &*image : nullptr, kept,
                     out.resumed);

@@ -76,6 +76,8 @@ RenderResult assembled(const RenderContext& context, const RenderRequest& reques
     result.stats.pixels_converged = sink.converged();
     result.unfinished = sink.missing();
     result.spread = sink.spread();
+    result.aov_list = request.aovs;
+    result.aovs = sink.aovs();
     if (result.unfinished.empty()) {
         result.stats.error = estimate_error(
             result.image, result.spread, sink.error_sums(), sink.samples(), request.samples,
@@ -96,7 +98,8 @@ RenderResult render(const Scene& scene, const RenderRequest& request,
                     const RenderOptions& options) {
     const auto start = Clock::now();
     const RenderContext context(scene);
-    ImageSink sink(scene.settings.width, scene.settings.height, context.tiles());
+    ImageSink sink(scene.settings.width, scene.settings.height, context.tiles(),
+                   aov_channel_count(request.aovs));
     RenderResult result = complete_render(context, request, sink, options);
     result.stats.seconds = seconds_since(start);
     return result;
