@@ -29,6 +29,7 @@ declare -A caption=(
     [glass-bunny]="Test1's room with the glass sphere replaced by the Stanford bunny (69 451 triangles) in the thesis's Glass made glossy (n 200): blurry refraction, soft shadows of a mesh from two lights."
     [spot-marble]="Spot the cow (5 856 triangles) in marble on a checker floor, depth of field focused on the cow; a near and a far sphere blur."
     [moving-teapot]="A porcelain Utah teapot (6 320 triangles) sliding to the right while the shutter is open (motion blur of a mesh), beside a glossy copper teapot standing still."
+    [obj-house]="A house in its OBJ file's own MTL materials: textured glossy roof (map_Kd), see-through window, emitting lamp, and a picket fence cut out of two quads by map_d, whose shadow on the grass has the gaps between the pickets."
     [checker-teapot]="A checker-textured teapot under a red sphere whose soft shadow falls onto it, Spot in bump-mapped glossy gold, and a single Triangle as a glossy mirror behind them."
 )
 
@@ -38,7 +39,7 @@ body=$(mktemp)
 trap 'rm -f "$stats" "$body"' EXIT
 field() { sed -n "s/.*\"$1\": *\([0-9.e+-]*\).*/\1/p" "$stats" | head -n1; }
 
-for scene in scenes/thesis/*.xml scenes/figures/*.xml scenes/meshes/*.xml; do
+for scene in scenes/thesis/*.xml scenes/figures/*.xml scenes/meshes/*.xml scenes/assets/obj-house.xml; do
     name=$(basename "$scene" .xml)
     build/drt "$scene" -o "docs/images/$name.png" --stats "$stats" -q "$@"
     seconds=$(printf '%.1f' "$(field seconds)")
