@@ -451,8 +451,6 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
                        "Keep finished work in FILE (with several scenes, a folder); running the "
                        "same command again resumes from it; removed when the render completes");
     job.goal.add_to(app, {threshold, checkpoint, aov});
-    // A checkpoint's tiles keep no AOVs.
-    aov->excludes(checkpoint);
     app.add_option("--checkpoint-every", job.checkpoint_seconds,
                    "Seconds between checkpoint writes (default 30)")
         ->check(CLI::NonNegativeNumber);

@@ -48,15 +48,15 @@ void open_checkpoint(const RenderContext& context, const RenderRequest& request,
     if (!options.checkpoint) return;
     const RenderSettings& settings = context.scene().settings;
     if (request.pixels != PixelChoice::kAll || request.paired ||
-        request.samples != settings.samples || request.seed != settings.seed ||
-        !request.aovs.empty()) {
+        request.samples != settings.samples || request.seed != settings.seed) {
         throw std::invalid_argument("a checkpoint of a request other than the scene's image");
     }
     std::string refused;
     if (leader) {
         try {
-            const RenderIdentity id = identify_render(
-                options.scene_files, settings, request.applied_adaptive(), context.tiles().size());
+            const RenderIdentity id =
+                identify_render(options.scene_files, settings, request.applied_adaptive(),
+                                context.tiles().size(), request.aovs);
             try {
                 check_replaceable(*options.checkpoint);
             } catch (const FileWriteError& e) {

@@ -783,8 +783,6 @@ TEST_F(CliTest, AovsAreExtraExrChannelsAndOtherOutputsAreRefused) {
          "drt: --aov: unknown AOV 'z' (known: albedo, normal, depth)\n"},
         {{"scene.xml", "scene.xml", "--aov", "depth", "-o", "out/"},
          "drt: --aov takes one scene, not a batch\n"},
-        {{"scene.xml", "--aov", "depth", "--checkpoint", "c", "-o", "a.exr"},
-         "drt: --aov excludes --checkpoint\n"},
         {{"scene.xml", "--aov", "depth", "--target-error", "0.1", "-o", "a.exr"},
          "drt: --aov excludes --target-error\n"},
     };
