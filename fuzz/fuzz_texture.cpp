@@ -9,9 +9,11 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     if (size < 1) return 0;
-    // The first byte picks the encoding; the rest is the file.
-    const auto encoding =
-        data[0] % 2 == 0 ? drt::TextureEncoding::kColor : drt::TextureEncoding::kData;
+    // The first byte picks the encoding (even: colour; 1 mod 4: alpha; 3 mod 4: data); the rest
+    // is the file.
+    const auto encoding = data[0] % 2 == 0   ? drt::TextureEncoding::kColor
+                          : data[0] % 4 == 1 ? drt::TextureEncoding::kAlpha
+                                             : drt::TextureEncoding::kData;
     const std::vector<unsigned char> file(data + 1, data + size);
     try {
         const drt::Image image = drt::decode_texture(file, "input", encoding);

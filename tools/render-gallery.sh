@@ -35,6 +35,7 @@ declare -A caption=(
     [test1-caustic]="Test1's room with its second light made physical (Falloff 1, radius 10): the ideal aqua glass sphere focuses it into a caustic on the floor in front of it (photon maps, one pass per sample)."
     [ring-cardioid]="A gold mirror ring (an open cylinder, ring.obj) under a low Falloff-1 point light: the light reflected off its inside gathers into a cardioid on the floor."
     [glass-bunny-caustic]="The glass bunny in ideal aqua glass under Test1-caustic's Falloff-1 light: the bunny's caustic on the floor."
+    [obj-house]="A house in its OBJ file's own MTL materials: textured glossy roof (map_Kd), see-through window, emitting lamp, and a picket fence cut out of two quads by map_d, whose shadow on the grass has the gaps between the pickets."
     [checker-teapot]="A checker-textured teapot under a red sphere whose soft shadow falls onto it, Spot in bump-mapped glossy gold, and a single Triangle as a glossy mirror behind them."
 )
 
@@ -44,7 +45,8 @@ body=$(mktemp)
 trap 'rm -f "$stats" "$body"' EXIT
 field() { sed -n "s/.*\"$1\": *\([0-9.e+-]*\).*/\1/p" "$stats" | head -n1; }
 
-for scene in scenes/thesis/*.xml scenes/figures/*.xml scenes/meshes/*.xml scenes/caustics/*.xml scenes/gi/*.xml; do
+for scene in scenes/thesis/*.xml scenes/figures/*.xml scenes/meshes/*.xml scenes/assets/obj-house.xml \
+    scenes/gi/*.xml scenes/caustics/*.xml; do
     name=$(basename "$scene" .xml)
     build/drt "$scene" -o "docs/images/$name.png" --stats "$stats" -q "$@"
     seconds=$(printf '%.1f' "$(field seconds)")

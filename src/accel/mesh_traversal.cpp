@@ -146,7 +146,7 @@ constexpr int kStackSize = 7 * 64 + 1;
 
 }  // namespace
 
-template <bool kAnyHit>
+template <bool kAnyHit, bool kAlpha>
 TriangleMesh::Answer<kAnyHit> TriangleMesh::traverse(const Ray& ray, Interval range,
                                                      std::uint64_t* tests) const {
     if (tree_.empty()) return {};
@@ -226,7 +226,7 @@ TriangleMesh::Answer<kAnyHit> TriangleMesh::traverse(const Ray& ray, Interval ra
                     if (use_filter) {
                         const auto verdict = filter.classify(gather(first, lanes), filter_near, far,
                                                              certain_low, certain_high);
-                        if (verdict.certain & maybe) return true;
+                        if (!kAlpha && (verdict.certain & maybe)) return true;
                         maybe &= verdict.maybe;
                     }
                 } else if (use_filter) {
@@ -237,6 +237,9 @@ TriangleMesh::Answer<kAnyHit> TriangleMesh::traverse(const Ray& ray, Interval ra
                     const auto [a, b, c] = corners(i);
                     if (!sheared) sheared.emplace(ray);
                     if (const auto hit = intersect_triangle(*sheared, a, b, c, range)) {
+                        if constexpr (kAlpha) {
+                            if (!opaque(i, hit->b)) continue;
+                        }
                         if constexpr (kAnyHit) {
                             return true;
                         } else {
@@ -318,11 +321,21 @@ TriangleMesh::Answer<kAnyHit> TriangleMesh::traverse(const Ray& ray, Interval ra
 }
 
 std::optional<MeshHit> TriangleMesh::intersect(const Ray& ray, Interval range) const {
-    return traverse<false>(ray, range);
+    return alpha_ ? traverse<false, true>(ray, range) : traverse<false>(ray, range);
 }
 
 bool TriangleMesh::occluded(const Ray& ray, Interval range) const {
-    return traverse<true>(ray, range);
+    return alpha_ ? traverse<true, true>(ray, range) : traverse<true>(ray, range);
+}
+
+bool TriangleMesh::opaque(std::uint32_t triangle, const Barycentrics& b) const {
+    Vec2 uv{0, 0};
+    if (has_texcoords()) {
+        const std::array<Vec2, 3> c = corner_texcoords(triangle);
+        uv = {b.b0 * c[0].x + b.b1 * c[1].x + b.b2 * c[2].x,
+              b.b0 * c[0].y + b.b1 * c[1].y + b.b2 * c[2].y};
+    }
+    return alpha_->bilinear(0, uv).r >= 0.5;
 }
 
 std::uint64_t TriangleMesh::triangle_tests(const Ray& ray, Interval range, bool any_hit) const {

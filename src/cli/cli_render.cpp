@@ -20,6 +20,7 @@
 #include "drt/io/image.h"
 #include "drt/job/mpi_work.h"
 #include "drt/job/render_job.h"
+#include "drt/render/aov.h"
 #include "drt/render/error_estimate.h"
 #include "drt/render/render_plan.h"
 #include "drt/scene/render_limits.h"
@@ -107,6 +108,7 @@ struct RenderCommand {
     bool estimate_shown = true;
     std::string checkpoint;   // a file, or with several scenes a folder of <scene>.checkpoint
     std::string error_image;  // one scene only: where its per-pixel standard error goes
+    std::vector<Aov> aovs;    // --aov: one scene with an .exr output only
     double checkpoint_seconds = 30;
     std::optional<std::size_t> stop_after_tiles;
     bool grid_order = false;
@@ -140,6 +142,14 @@ ImageWriteOptions output_options(const Scene& scene, const RenderResult& result,
         options.attributes.push_back({"estimatedRelMSE", *result.stats.error.relmse});
     }
     return options;
+}
+
+bool is_exr_path(const std::string& path) {
+    try {
+        return format_for_path(path) == ImageFormat::kExr;
+    } catch (const ImageError&) {
+        return false;
+    }
 }
 
 // Channel values that are NaN or infinite: radiance beyond the float range (a light of 1e39).
@@ -290,6 +300,7 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
     // Photon-mapped caustics get no estimate (renderer.h): its second renders would be wasted.
     request.estimate_error = (job.estimate_shown || format_for_path(output) == ImageFormat::kExr) &&
                              !plan_render(scene).effects.caustics;
+    request.aovs = job.aovs;
     RenderJobOptions options;
     options.threads = job.threads;
     options.checkpoint = checkpoint;
@@ -339,8 +350,12 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
     const fs::path target = !r.complete()   ? partial_path(output)
                             : nonfinite > 0 ? nonfinite_path(output)
                                             : output;
+    ImageWriteOptions written = output_options(scene, result, job);
+    if (!result.aov_list.empty() && format_for_path(target) == ImageFormat::kExr) {
+        written.extra = {aov_channel_names(result.aov_list), result.aovs};
+    }
     try {
-        write_image(result.image, target, output_options(scene, result, job));
+        write_image(result.image, target, written);
     } catch (const ImageError& e) {
         err << "drt: " << e.what() << "\n";
         outcome.status = job.agree(kFailed);
@@ -421,7 +436,7 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
         "drt converge SCENE.xml --spp 1,4,16",
         "drt"};
     std::vector<std::string> scenes;
-    std::string output, stats;
+    std::string output, stats, aov_list;
     RenderCommand job;
     bool force_progress = false;
     app.add_option("scenes", scenes, "Scene file(s) in the thesis XML format")->required();
@@ -437,13 +452,17 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
     app.add_option("--error-image", job.error_image,
                    "Write each pixel's estimated standard error (per channel, linear) to FILE "
                    "(.png, .bmp, .pfm, .exr)");
+    CLI::Option* aov = app.add_option(
+        "--aov", aov_list,
+        "With an .exr output, also write first-hit AOVs as extra channels: a comma-separated "
+        "list of albedo, normal, depth");
     app.add_flag("-q,--quiet", job.quiet, "No progress display or messages besides errors");
     app.add_flag("--progress", force_progress, "Show progress even when stderr is not a terminal");
     CLI::Option* checkpoint =
         app.add_option("--checkpoint", job.checkpoint,
                        "Keep finished work in FILE (with several scenes, a folder); running the "
                        "same command again resumes from it; removed when the render completes");
-    job.goal.add_to(app, {threshold, checkpoint});
+    job.goal.add_to(app, {threshold, checkpoint, aov});
     app.add_option("--checkpoint-every", job.checkpoint_seconds,
                    "Seconds between checkpoint writes (default 30)")
         ->check(CLI::NonNegativeNumber);
@@ -497,6 +516,27 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
     if (batch && !job.error_image.empty()) {
         err << "drt: --error-image takes one scene, not a batch\nRun 'drt --help' for usage.\n";
         return kBadInput;
+    }
+    if (aov->count() > 0) {
+        try {
+            job.aovs = parse_aovs(aov_list);
+        } catch (const std::invalid_argument& e) {
+            err << "drt: --aov: " << e.what() << "\nRun 'drt --help' for usage.\n";
+            return kBadInput;
+        }
+        std::string refused;
+        if (batch) {
+            refused = "takes one scene, not a batch";
+        } else if (output.empty() || fs::path(output).extension().string().empty() ||
+                   !is_exr_path(output)) {
+            refused =
+                "needs an .exr output (-o FILE.exr): only OpenEXR holds the extra "
+                "channels";
+        }
+        if (!refused.empty()) {
+            err << "drt: --aov " << refused << "\nRun 'drt --help' for usage.\n";
+            return kBadInput;
+        }
     }
     if (report.wanted && !(batch && !output.empty())) {
         err << "drt: --report needs a batch: -o DIR/\nRun 'drt --help' for usage.\n";

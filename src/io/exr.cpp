@@ -104,6 +104,19 @@ Bytes encode_exr(const Image& image, const ImageWriteOptions& options, const fs:
             frame.insert(names[c], Imf::Slice(type, const_cast<char*>(base + c * value_size),
                                               x_stride, y_stride));
         }
+        const std::size_t extra = options.extra.names.size();
+        std::vector<half> extra_halves;
+        if (options.half)
+            extra_halves.assign(options.extra.values.begin(), options.extra.values.end());
+        const char* const extra_base =
+            options.half ? reinterpret_cast<const char*>(extra_halves.data())
+                         : reinterpret_cast<const char*>(options.extra.values.data());
+        for (std::size_t c = 0; c < extra; ++c) {
+            const std::string& name = options.extra.names[c];
+            header.channels().insert(name, Imf::Channel(type));
+            frame.insert(name, Imf::Slice(type, const_cast<char*>(extra_base + c * value_size),
+                                          extra * value_size, extra * value_size * image.width));
+        }
         MemoryOStream stream(file, path);
         Imf::OutputFile out(stream, header, 0);
         out.setFrameBuffer(frame);
@@ -170,6 +183,38 @@ Image decode_exr(const Bytes& data, const fs::path& path) {
         throw;
     } catch (const std::bad_alloc&) {
         throw fail("OpenEXR image too large");
+    } catch (const std::exception& e) {
+        throw fail("cannot read OpenEXR image: " + printable(e.what()));
+    }
+}
+
+std::vector<float> decode_exr_channel(const Bytes& data, const std::string& name,
+                                      const fs::path& path) {
+    const auto fail = [&](const std::string& what) -> ImageError {
+        return ImageError(printable(path.string()) + ": " + what);
+    };
+    try {
+        MemoryIStream stream(data, path);
+        Imf::InputFile in(stream, 0);
+        const Imath::Box2i window = in.header().dataWindow();
+        const long long w = static_cast<long long>(window.max.x) - window.min.x + 1;
+        const long long h = static_cast<long long>(window.max.y) - window.min.y + 1;
+        if (w <= 0 || h <= 0 || w > kMaxImageSide || h > kMaxImageSide ||
+            static_cast<std::uint64_t>(w * h) > kMaxPixels) {
+            throw fail("bad OpenEXR data window");
+        }
+        if (!in.header().channels().findChannel(name)) {
+            throw fail("OpenEXR image has no channel " + printable(name));
+        }
+        std::vector<float> values(static_cast<std::size_t>(w * h));
+        Imf::FrameBuffer frame;
+        frame.insert(name, Imf::Slice::Make(Imf::FLOAT, values.data(), window, sizeof(float),
+                                            sizeof(float) * static_cast<std::size_t>(w)));
+        in.setFrameBuffer(frame);
+        in.readPixels(window.min.y, window.max.y);
+        return values;
+    } catch (const ImageError&) {
+        throw;
     } catch (const std::exception& e) {
         throw fail("cannot read OpenEXR image: " + printable(e.what()));
     }

@@ -261,6 +261,13 @@ void write_image(const Image& image, const fs::path& path, const ImageWriteOptio
     if (image.rgb.size() != 3 * static_cast<std::size_t>(image.width) * image.height) {
         fail(path, "image data does not match its size");
     }
+    if (!options.extra.names.empty() && format != ImageFormat::kExr) {
+        fail(path, "only an .exr file holds channels besides R, G and B");
+    }
+    if (options.extra.values.size() !=
+        options.extra.names.size() * static_cast<std::size_t>(image.width) * image.height) {
+        fail(path, "extra channel data does not match the image's size");
+    }
     const Bytes file = format == ImageFormat::kPfm   ? encode_pfm(image)
                        : format == ImageFormat::kExr ? encode_exr(image, options, path)
                                                      : encode_8bit(image, format, path);
@@ -269,6 +276,10 @@ void write_image(const Image& image, const fs::path& path, const ImageWriteOptio
     } catch (const FileWriteError& e) {
         throw ImageError(e.what());
     }
+}
+
+std::vector<float> read_exr_channel(const fs::path& path, const std::string& name) {
+    return decode_exr_channel(read_image_file(path), name, path);
 }
 
 Image read_image(const fs::path& path) {

@@ -124,12 +124,14 @@ Image decode_stb(const Bytes& data, const fs::path& path, Kind kind, TextureEnco
     const bool hdr = kind == Kind::kHdr;
     const bool wide = !hdr && stbi_is_16_bit_from_memory(data.data(), size);
     StbPixels pixels(nullptr, &stbi_image_free);
+    const bool alpha = encoding == TextureEncoding::kAlpha;
+    const int wanted = alpha ? 4 : 3;
     if (hdr) {
-        pixels.reset(stbi_loadf_from_callbacks(&callbacks, &reader, &w, &h, &channels, 3));
+        pixels.reset(stbi_loadf_from_callbacks(&callbacks, &reader, &w, &h, &channels, wanted));
     } else if (wide) {
-        pixels.reset(stbi_load_16_from_callbacks(&callbacks, &reader, &w, &h, &channels, 3));
+        pixels.reset(stbi_load_16_from_callbacks(&callbacks, &reader, &w, &h, &channels, wanted));
     } else {
-        pixels.reset(stbi_load_from_callbacks(&callbacks, &reader, &w, &h, &channels, 3));
+        pixels.reset(stbi_load_from_callbacks(&callbacks, &reader, &w, &h, &channels, wanted));
     }
     if (!pixels) {
         const char* reason = stbi_failure_reason();
@@ -137,7 +139,22 @@ Image decode_stb(const Bytes& data, const fs::path& path, Kind kind, TextureEnco
     }
     if (reader.past_end) fail(path, "truncated image file");
     Image image(w, h);
-    if (hdr) {
+    if (alpha) {
+        const auto value = [&](std::size_t i) -> double {
+            if (hdr) return static_cast<const float*>(pixels.get())[i];
+            if (wide) return static_cast<const stbi_us*>(pixels.get())[i] / 65535.0;
+            return static_cast<const stbi_uc*>(pixels.get())[i] / 255.0;
+        };
+        // Grey with alpha, or colour with alpha: the alpha channel; otherwise the luminance.
+        const bool has_alpha = channels == 2 || channels == 4;
+        for (std::size_t p = 0; p < static_cast<std::size_t>(w) * h; ++p) {
+            const double a = has_alpha
+                                 ? value(4 * p + 3)
+                                 : luminance({value(4 * p), value(4 * p + 1), value(4 * p + 2)});
+            const auto x = static_cast<int>(p % static_cast<std::size_t>(w));
+            image.set(x, static_cast<int>(p / static_cast<std::size_t>(w)), {a, a, a});
+        }
+    } else if (hdr) {
         const float* p = static_cast<const float*>(pixels.get());
         std::copy(p, p + image.rgb.size(), image.rgb.begin());
     } else if (wide) {
@@ -164,6 +181,13 @@ Image decode_texture(const Bytes& data, const fs::path& path, TextureEncoding en
     const Kind kind = kind_of(data, path);
     if (kind != Kind::kExr) return decode_stb(data, path, kind, encoding);
     Image image = decode_exr(data, path);
+    if (encoding == TextureEncoding::kAlpha) {
+        for (std::size_t i = 0; i < image.rgb.size(); i += 3) {
+            const auto a =
+                static_cast<float>(luminance({image.rgb[i], image.rgb[i + 1], image.rgb[i + 2]}));
+            image.rgb[i] = image.rgb[i + 1] = image.rgb[i + 2] = a;
+        }
+    }
     for (const float v : image.rgb) {
         if (!std::isfinite(v)) fail(path, "image holds a value that is not a finite number");
     }

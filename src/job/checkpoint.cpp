@@ -25,11 +25,16 @@ using Bytes = std::vector<unsigned char>;
 // "DRTCKPT" and a format number, raised whenever the layout changes (the tile codec's included):
 // a reader refuses a format it does not know instead of guessing. Format 5 is format 4 with each
 // tile's diffuse ray count (DiffuseCount::kCarried): a path render's; a distributed render writes
-// format 4.
+// format 4. Formats 6 and 7 are 4 and 5 with AOVs (--aov): the count of each pixel's AOV values
+// after the tile count, and the values in each tile.
 constexpr char kMagic[8] = {'D', 'R', 'T', 'C', 'K', 'P', 'T', '4'};
 constexpr char kFormatWithoutDiffuse = '4', kFormatWithDiffuse = '5';
+constexpr char kAovFormatWithoutDiffuse = '6', kAovFormatWithDiffuse = '7';
 
-char format_of(DiffuseCount diffuse) {
+char format_of(DiffuseCount diffuse, std::uint32_t aov_channels) {
+    if (aov_channels > 0) {
+        return diffuse == DiffuseCount::kCarried ? kAovFormatWithDiffuse : kAovFormatWithoutDiffuse;
+    }
     return diffuse == DiffuseCount::kCarried ? kFormatWithDiffuse : kFormatWithoutDiffuse;
 }
 
@@ -68,10 +73,11 @@ class Reader {
         return s;
     }
     // A tile of `grid`, not one of those marked in `seen`, which it then marks.
-    TileBuffer tile(std::span<const Tile> grid, std::vector<bool>& seen, DiffuseCount diffuse) {
+    TileBuffer tile(std::span<const Tile> grid, std::vector<bool>& seen, DiffuseCount diffuse,
+                    std::uint32_t aov_channels) {
         std::span<const unsigned char> rest = bytes_.subspan(pos_);
         try {
-            TileBuffer t = take_tile(rest, grid, seen, diffuse);
+            TileBuffer t = take_tile(rest, grid, seen, diffuse, aov_channels);
             pos_ = bytes_.size() - rest.size();
             return t;
         } catch (const TileCodecError& e) {
@@ -161,8 +167,8 @@ std::uint64_t hash_bytes(std::span<const unsigned char> bytes) {
 }
 
 RenderIdentity identify_render(std::span<const fs::path> files, const RenderSettings& settings,
-                               const std::optional<AdaptiveSampling>& adaptive,
-                               std::uint64_t tiles) {
+                               const std::optional<AdaptiveSampling>& adaptive, std::uint64_t tiles,
+                               std::span<const Aov> aovs) {
     RenderIdentity id;
     id.version = DRT_VERSION;
     for (const fs::path& f : files) {
@@ -184,19 +190,25 @@ RenderIdentity identify_render(std::span<const fs::path> files, const RenderSett
         options << " noise_threshold " << exact(adaptive->noise_threshold) << " min_spp "
                 << adaptive->min_samples;
     }
+    // Only a render with AOVs names them, so that other renders keep their identity.
+    if (!aovs.empty()) {
+        options << " aovs";
+        for (const std::string& name : aov_channel_names(aovs)) options << " " << name;
+    }
     const std::string text = options.str();
     id.options = hash_bytes({reinterpret_cast<const unsigned char*>(text.data()), text.size()});
     id.width = settings.width;
     id.height = settings.height;
     id.tiles = tiles;
     id.diffuse = diffuse_count_for(settings);
+    id.aov_channels = static_cast<std::uint32_t>(aov_channel_count(aovs));
     return id;
 }
 
 std::vector<unsigned char> encode_checkpoint(const RenderIdentity& id,
                                              std::span<const TileBuffer> tiles) {
     Writer w{Bytes(std::begin(kMagic), std::end(kMagic))};
-    w.bytes.back() = static_cast<unsigned char>(format_of(id.diffuse));
+    w.bytes.back() = static_cast<unsigned char>(format_of(id.diffuse, id.aov_channels));
     w.text(id.version);
     w.u64(id.files.size());
     for (const FileFingerprint& f : id.files) {
@@ -208,7 +220,8 @@ std::vector<unsigned char> encode_checkpoint(const RenderIdentity& id,
     w.u32(static_cast<std::uint32_t>(id.height));
     w.u64(id.tiles);
     w.u64(tiles.size());
-    for (const TileBuffer& t : tiles) append_tile(w.bytes, t, id.diffuse);
+    if (id.aov_channels > 0) w.u32(id.aov_channels);
+    for (const TileBuffer& t : tiles) append_tile(w.bytes, t, id.diffuse, id.aov_channels);
     w.u64(hash_bytes(w.bytes));
     return std::move(w.bytes);
 }
@@ -219,9 +232,10 @@ Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<con
         fail(file, "not a drt checkpoint");
     }
     const unsigned char format = bytes[sizeof kMagic - 1];
-    if (format != kFormatWithoutDiffuse && format != kFormatWithDiffuse) {
+    if (format != kFormatWithoutDiffuse && format != kFormatWithDiffuse &&
+        format != kAovFormatWithoutDiffuse && format != kAovFormatWithDiffuse) {
         fail(file, std::string("checkpoint format ") + printable_format(format) +
-                       " of another drt version, this one reads format " + format_of(expected) +
+                       " of another drt version, this one reads format " + format_of(expected, 0) +
                        ": not resumed and nothing written (delete it or name another "
                        "--checkpoint file)");
     }
@@ -234,7 +248,9 @@ Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<con
     Reader r(body.subspan(sizeof kMagic), file);
     Checkpoint c;
     RenderIdentity& id = c.identity;
-    id.diffuse = format == kFormatWithDiffuse ? DiffuseCount::kCarried : DiffuseCount::kOmitted;
+    id.diffuse = format == kFormatWithDiffuse || format == kAovFormatWithDiffuse
+                     ? DiffuseCount::kCarried
+                     : DiffuseCount::kOmitted;
     id.version = r.text(kMaxVersionLength);
     const std::uint64_t files = r.u64();
     // Each takes at least 12 bytes, so a damaged count soon runs out of file.
@@ -250,8 +266,16 @@ Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<con
     if (id.tiles != grid.size()) fail(file, "checkpoint of another image size");
     const std::uint64_t count = r.u64();
     if (count > grid.size()) fail(file, "damaged checkpoint (more tiles than the image has)");
+    if (format == kAovFormatWithoutDiffuse || format == kAovFormatWithDiffuse) {
+        id.aov_channels = r.u32();
+        if (id.aov_channels == 0 || id.aov_channels > 7) {
+            fail(file, "damaged checkpoint (bad AOV channel count)");
+        }
+    }
     std::vector<bool> seen(grid.size(), false);
-    for (std::uint64_t i = 0; i < count; ++i) c.tiles.push_back(r.tile(grid, seen, id.diffuse));
+    for (std::uint64_t i = 0; i < count; ++i) {
+        c.tiles.push_back(r.tile(grid, seen, id.diffuse, id.aov_channels));
+    }
     if (r.left() != 0) fail(file, "damaged checkpoint (bytes after the last tile)");
     return c;
 }
@@ -275,7 +299,8 @@ std::optional<Checkpoint> read_checkpoint(const fs::path& file, const RenderIden
     } else if (got.width != expected.width || got.height != expected.height) {
         differs = "another image size (" + std::to_string(got.width) + "x" +
                   std::to_string(got.height) + ")";
-    } else if (got.options != expected.options || got.tiles != expected.tiles) {
+    } else if (got.options != expected.options || got.tiles != expected.tiles ||
+               got.aov_channels != expected.aov_channels) {
         differs = "other options (samples, seed, sampler or another setting differs)";
     }
     if (!differs.empty()) {

@@ -188,9 +188,10 @@ int receive_int(const Transport& transport, int from, int tag) {
 
 // A finished tile from process `from`; a damaged message is a failure of the job's transport.
 TileBuffer received_tile(std::span<const unsigned char> bytes, const RenderContext& context,
-                         int from) {
+                         std::size_t aov_channels, int from) {
     try {
-        return decode_tile(bytes, context.tiles(), diffuse_count_for(context.scene().settings));
+        return decode_tile(bytes, context.tiles(), diffuse_count_for(context.scene().settings),
+                           aov_channels);
     } catch (const TileCodecError& e) {
         throw std::runtime_error("MPI: a tile message from process " + std::to_string(from) + ": " +
                                  e.what());
@@ -254,8 +255,8 @@ class LeaderQueue final : public TileSource {
 
 // The leader's communication thread: answers requests, passes finished tiles to the sink and
 // takes back unrendered ones, until every other process has said it is done.
-void serve(const Transport& transport, const RenderContext& context, LeaderQueue& queue,
-           TileSink& sink, MpiShare& share, std::exception_ptr& error) {
+void serve(const Transport& transport, const RenderContext& context, std::size_t aov_channels,
+           LeaderQueue& queue, TileSink& sink, MpiShare& share, std::exception_ptr& error) {
     const auto seconds = [](Clock::time_point from, Clock::time_point to) {
         return std::chrono::duration<double>(to - from).count();
     };
@@ -286,7 +287,7 @@ void serve(const Transport& transport, const RenderContext& context, LeaderQueue
                 if (error) break;  // drain the others, but add nothing more
                 const Clock::time_point received = Clock::now();
                 try {
-                    sink.add(received_tile(bytes, context, from));
+                    sink.add(received_tile(bytes, context, aov_channels, from));
                 } catch (...) {
                     error = std::current_exception();
                     queue.close();
@@ -363,10 +364,11 @@ class WorkerQueue final : public TileSource {
 // Finished tiles of another process, encoded, waiting to be sent by its communication thread.
 class Outbox final : public TileSink {
   public:
-    Outbox(Doorbell& added, DiffuseCount diffuse) : added_(added), diffuse_(diffuse) {}
+    Outbox(Doorbell& added, DiffuseCount diffuse, std::size_t aov_channels)
+        : added_(added), diffuse_(diffuse), aov_channels_(aov_channels) {}
 
     void add(TileBuffer buffer) override {
-        std::vector<unsigned char> bytes = encode_tile(buffer, diffuse_);
+        std::vector<unsigned char> bytes = encode_tile(buffer, diffuse_, aov_channels_);
         {
             const std::lock_guard lock(mutex_);
             messages_.push_back(std::move(bytes));
@@ -386,6 +388,7 @@ class Outbox final : public TileSink {
     std::deque<std::vector<unsigned char> > messages_;
     Doorbell& added_;
     DiffuseCount diffuse_;
+    std::size_t aov_channels_;
 };
 
 // Another process's communication thread: keeps `threads` tiles ahead of its workers, sends
@@ -506,7 +509,10 @@ MpiShare MpiJob::render_tiles(const RenderContext& context, const RenderRequest&
         LeaderQueue queue(std::move(todo), options.stop);
         MpiShare share;
         std::exception_ptr served_error;
-        std::jthread server([&] { serve(*transport_, context, queue, sink, share, served_error); });
+        std::jthread server([&] {
+            serve(*transport_, context, aov_channel_count(request.aovs), queue, sink, share,
+                  served_error);
+        });
         std::exception_ptr error;
         try {
             share.threads = drt::render_tiles(context, request, queue, sink, run);
@@ -528,7 +534,8 @@ MpiShare MpiJob::render_tiles(const RenderContext& context, const RenderRequest&
     run.on_progress = nullptr;
     Doorbell doorbell;
     WorkerQueue queue(context.tiles().size(), options.stop, doorbell);
-    Outbox outbox(doorbell, diffuse_count_for(context.scene().settings));
+    Outbox outbox(doorbell, diffuse_count_for(context.scene().settings),
+                  aov_channel_count(request.aovs));
     std::atomic<bool> workers_finished{false};
     std::jthread communicator([&] {
         work_for_leader(*transport_, context, queue, outbox, run.threads, workers_finished,

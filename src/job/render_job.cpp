@@ -54,8 +54,9 @@ void open_checkpoint(const RenderContext& context, const RenderRequest& request,
     std::string refused;
     if (leader) {
         try {
-            const RenderIdentity id = identify_render(
-                options.scene_files, settings, request.applied_adaptive(), context.tiles().size());
+            const RenderIdentity id =
+                identify_render(options.scene_files, settings, request.applied_adaptive(),
+                                context.tiles().size(), request.aovs);
             try {
                 check_replaceable(*options.checkpoint);
             } catch (const FileWriteError& e) {
@@ -115,7 +116,10 @@ RenderJobResult run_job(const RenderContext& context, const RenderRequest& asked
 
     // Only the leader assembles the image and keeps the checkpoint.
     std::optional<ImageSink> image;
-    if (leader) image.emplace(scene.settings.width, scene.settings.height, context.tiles());
+    if (leader) {
+        image.emplace(scene.settings.width, scene.settings.height, context.tiles(),
+                      aov_channel_count(request.aovs));
+    }
     std::optional<CheckpointSink> kept;
     open_checkpoint(context, request, options, leader, image ? &*image : nullptr, kept,
                     out.resumed);

@@ -67,9 +67,13 @@ DiffuseCount diffuse_count_for(const RenderSettings& settings) {
                                                         : DiffuseCount::kOmitted;
 }
 
-void append_tile(std::vector<unsigned char>& bytes, const TileBuffer& t, DiffuseCount diffuse) {
+void append_tile(std::vector<unsigned char>& bytes, const TileBuffer& t, DiffuseCount diffuse,
+                 std::size_t aov_channels) {
     if (diffuse == DiffuseCount::kOmitted && t.rays.diffuse != 0) {
         throw std::invalid_argument("a tile's diffuse rays in a layout without them");
+    }
+    if (t.aovs.size() != aov_channels * t.pixel_samples.size()) {
+        throw std::invalid_argument("a tile's AOVs do not match the layout");
     }
     Writer w(bytes);
     w.u64(t.tile.index);
@@ -87,16 +91,18 @@ void append_tile(std::vector<unsigned char>& bytes, const TileBuffer& t, Diffuse
     if (diffuse == DiffuseCount::kCarried) w.u64(t.rays.diffuse);
     w.u64(t.samples);
     w.u64(t.converged);
+    for (float v : t.aovs) w.f32(v);
 }
 
-std::vector<unsigned char> encode_tile(const TileBuffer& tile, DiffuseCount diffuse) {
+std::vector<unsigned char> encode_tile(const TileBuffer& tile, DiffuseCount diffuse,
+                                       std::size_t aov_channels) {
     std::vector<unsigned char> bytes;
-    append_tile(bytes, tile, diffuse);
+    append_tile(bytes, tile, diffuse, aov_channels);
     return bytes;
 }
 
 TileBuffer take_tile(std::span<const unsigned char>& bytes, std::span<const Tile> grid,
-                     std::vector<bool>& seen, DiffuseCount diffuse) {
+                     std::vector<bool>& seen, DiffuseCount diffuse, std::size_t aov_channels) {
     Reader r(bytes);
     const std::uint64_t index = r.u64();
     if (index >= grid.size() || seen[index]) {
@@ -124,14 +130,17 @@ TileBuffer take_tile(std::span<const unsigned char>& bytes, std::span<const Tile
     if (diffuse == DiffuseCount::kCarried) t.rays.diffuse = r.u64();
     t.samples = r.u64();
     t.converged = r.u64();
+    t.aovs.resize(aov_channels * t.pixel_samples.size());
+    r.need(t.aovs.size() * 4);
+    for (float& v : t.aovs) v = r.f32();
     bytes = r.rest();
     return t;
 }
 
 TileBuffer decode_tile(std::span<const unsigned char> bytes, std::span<const Tile> grid,
-                       DiffuseCount diffuse) {
+                       DiffuseCount diffuse, std::size_t aov_channels) {
     std::vector<bool> seen(grid.size(), false);
-    TileBuffer t = take_tile(bytes, grid, seen, diffuse);
+    TileBuffer t = take_tile(bytes, grid, seen, diffuse, aov_channels);
     if (!bytes.empty()) throw TileCodecError(TileCodecError::Problem::bytes_after);
     return t;
 }

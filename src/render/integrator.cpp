@@ -21,10 +21,10 @@ constexpr int kRedrawAttempts = 32;
 // (cos θ = 1 in the cone): a light whose area is not sampled acts as a point there.
 constexpr Vec2 kLightCentre{0, 0};
 
-// The surface at a hit. A camera ray filters image textures over the footprint of one of its
-// pixel's `samples` camera samples (1/√samples of a pixel across, as pbrt-v4 scales its
-// differentials, but at least an eighth); deeper rays, whose spread the camera does not know,
-// read the finest level.
+}  // namespace
+
+// A camera ray's footprint is 1/√samples of a pixel across, as pbrt-v4 scales its
+// differentials, but at least an eighth.
 SurfaceHit surface_of(const Ray& ray, const Hit& hit, int depth, const Camera& camera,
                       int samples) {
     if (depth > 0 || !hit.object->reads_uv()) return hit.object->surface_at(ray, hit);
@@ -32,8 +32,6 @@ SurfaceHit surface_of(const Ray& ray, const Hit& hit, int depth, const Camera& c
     const RayDifferential differential = camera.differential(ray, step);
     return hit.object->surface_at(ray, hit, &differential);
 }
-
-}  // namespace
 
 Vec3 reflect_above(const Vec3& d, const Vec3& shading, const Vec3& geometric) {
     const Vec3 r = reflect(d, shading);

@@ -88,6 +88,8 @@ RenderContext::RenderContext(const Scene& scene)
                    : nullptr),
       area_integrator_(make_integrator(scene, area_plan_, bvh_, *sampler_, photons_.get())),
       centre_integrator_(make_integrator(scene, centre_plan_, bvh_, *sampler_, photons_.get())),
+      area_aovs_(scene, area_plan_, bvh_, *sampler_),
+      centre_aovs_(scene, centre_plan_, bvh_, *sampler_),
       tiles_(tile_grid(scene.settings.width, scene.settings.height)) {}
 
 const RenderPlan& RenderContext::plan(const RenderRequest& request) const {
@@ -194,9 +196,11 @@ std::vector<std::size_t> RenderContext::rendered_in(const Tile& tile,
 }
 
 TileBuffer RenderContext::render_tile(const Tile& tile, const RenderRequest& request) const {
-    TileBuffer buffer{
-        tile, Image(tile.width(), tile.height()), {}, Image(tile.width(), tile.height()), {}, {}, 0,
-        0};
+    TileBuffer buffer{tile, Image(tile.width(), tile.height()),
+                      {},   Image(tile.width(), tile.height()),
+                      {},   {},
+                      0,    0,
+                      {}};
     const auto width = static_cast<std::size_t>(tile.width());
     Scratch scratch;
     std::vector<Pixel> pixels(width * static_cast<std::size_t>(tile.height()));
@@ -214,6 +218,19 @@ TileBuffer RenderContext::render_tile(const Tile& tile, const RenderRequest& req
         buffer.pixel_samples.push_back(pixel.samples);
         buffer.samples += pixel.samples;
         buffer.converged += pixel.converged ? 1 : 0;
+    }
+    if (!request.aovs.empty()) {
+        const std::size_t channels = aov_channel_count(request.aovs);
+        const AovTracer& tracer = request.samples > 1 ? area_aovs_ : centre_aovs_;
+        buffer.aovs.assign(channels * pixels.size(), 0.0f);
+        for (const std::size_t i : rendered) {
+            const int x = tile.x0 + static_cast<int>(i % width);
+            const int y = tile.y0 + static_cast<int>(i / width);
+            const PixelSample s{request.seed, static_cast<std::uint32_t>(pixel_index(scene_, x, y)),
+                                0, pixels[i].samples};
+            tracer.pixel_mean(x, y, s, request.aovs,
+                              std::span<float>(buffer.aovs).subspan(channels * i, channels));
+        }
     }
     if (request.paired) {
         render_again(request, tile, pixels, rendered, scratch, buffer);

@@ -80,6 +80,8 @@ RenderResult assembled(const RenderContext& context, const RenderRequest& reques
     result.stats.pixels_converged = sink.converged();
     result.unfinished = sink.missing();
     result.spread = sink.spread();
+    result.aov_list = request.aovs;
+    result.aovs = sink.aovs();
     if (result.plan.effects.caustics) {
         result.stats.error.unavailable =
             "caustics from photon maps are biased at any finite gather radius: no estimate";
@@ -103,7 +105,8 @@ RenderResult render(const Scene& scene, const RenderRequest& request,
                     const RenderOptions& options) {
     const auto start = Clock::now();
     const RenderContext context(scene);
-    ImageSink sink(scene.settings.width, scene.settings.height, context.tiles());
+    ImageSink sink(scene.settings.width, scene.settings.height, context.tiles(),
+                   aov_channel_count(request.aovs));
     RenderResult result = complete_render(context, request, sink, options);
     result.stats.seconds = seconds_since(start);
     return result;

@@ -24,11 +24,13 @@ std::optional<Tile> TileQueue::next() {
     return tiles_[i];
 }
 
-ImageSink::ImageSink(int width, int height, std::vector<Tile> grid)
+ImageSink::ImageSink(int width, int height, std::vector<Tile> grid, std::size_t aov_channels)
     : grid_(std::move(grid)),
       image_(width, height),
       pixel_samples_(static_cast<std::size_t>(width) * height, 0),
       spread_(width, height),
+      aov_channels_(aov_channels),
+      aovs_(aov_channels * static_cast<std::size_t>(width) * height, 0.0f),
       error_sums_(grid_.size()),
       done_(grid_.size(), false) {}
 
@@ -39,7 +41,8 @@ void ImageSink::add(TileBuffer buffer) {
     }
     if (buffer.pixels.width != t.width() || buffer.pixels.height != t.height() ||
         buffer.pixel_samples.size() != buffer.pixels.rgb.size() / 3 ||
-        buffer.spread.rgb.size() != buffer.pixels.rgb.size()) {
+        buffer.spread.rgb.size() != buffer.pixels.rgb.size() ||
+        buffer.aovs.size() != aov_channels_ * buffer.pixel_samples.size()) {
         throw std::invalid_argument("tile " + std::to_string(t.index) +
                                     ": buffer does not match the tile's size");
     }
@@ -56,6 +59,11 @@ void ImageSink::add(TileBuffer buffer) {
         std::copy_n(buffer.pixels.rgb.begin() + 3 * from, 3 * row, image_.rgb.begin() + 3 * to);
         std::copy_n(buffer.spread.rgb.begin() + 3 * from, 3 * row, spread_.rgb.begin() + 3 * to);
         std::copy_n(buffer.pixel_samples.begin() + from, row, pixel_samples_.begin() + to);
+        if (aov_channels_ > 0) {
+            std::copy_n(buffer.aovs.begin() + static_cast<std::ptrdiff_t>(aov_channels_ * from),
+                        aov_channels_ * row,
+                        aovs_.begin() + static_cast<std::ptrdiff_t>(aov_channels_ * to));
+        }
     }
     error_sums_[t.index] = buffer.error_sums;
     rays_ += buffer.rays;

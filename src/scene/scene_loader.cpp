@@ -927,6 +927,7 @@ class SceneReader {
         for (ObjPart& part : parts) {
             auto material = std::make_unique<Material>(default_obj_material());
             SurfaceSpec part_surface = surface;
+            std::shared_ptr<const MipMap> alpha;
             if (part.material == ObjMesh::kNoMaterial) {
                 grey_from(obj.first_face_without_material);
             } else {
@@ -935,14 +936,22 @@ class SceneReader {
                 if (found != library.end()) {
                     *material = material_from_mtl(found->second.mtl);
                     // The scene's own texture, when the Mesh names one, stands over map_Kd.
+                    const LibraryMaterial& mtl = found->second;
                     if (!part_surface.image && !part_surface.textured)
-                        part_surface.image = colour_map(found->second);
+                        part_surface.image =
+                            mtl_image(mtl, mtl.mtl.map_kd, TextureEncoding::kColor);
+                    alpha = mtl_image(mtl, mtl.mtl.map_d, TextureEncoding::kAlpha);
+                    // Likewise the scene's own bumps over the MTL's bump map.
+                    if (!part_surface.height && !part_surface.bump && mtl.mtl.bump) {
+                        part_surface.height = mtl_image(mtl, mtl.mtl.bump, TextureEncoding::kData);
+                        part_surface.bump_strength = mtl.mtl.bump->bump_multiplier;
+                    }
                 } else {
                     grey_from(name.line);
                 }
             }
-            if (!reads_uv(part_surface)) drop_texcoords(part.mesh);
-            auto mesh = build_mesh(in, std::move(part.mesh), transform, smooth);
+            if (!reads_uv(part_surface) && !alpha) drop_texcoords(part.mesh);
+            auto mesh = build_mesh(in, std::move(part.mesh), transform, smooth, std::move(alpha));
             dropped += mesh->dropped();
             collapsed += mesh->collapsed();
             const Material* own = material.get();
@@ -1023,38 +1032,42 @@ class SceneReader {
         return {folder / name};
     }
 
-    // Images of an MTL material: a missing one is warned about at its line and its constant
-    // colour stands; an alpha or bump map that exists is not applied yet, which is said too.
+    // Images of an MTL material: a missing one is warned about at its line, and the material
+    // goes without it (its constant colour, no cut-out, no bumps).
     void warn_missing_images(const MtlMaterial& m, const std::filesystem::path& mtl_path) {
         for (const auto* image : {&m.map_kd, &m.map_d, &m.bump}) {
             if (!*image) continue;
             const std::filesystem::path file = mtl_path.parent_path() / (*image)->path;
             std::error_code error;
-            const bool exists = std::filesystem::is_regular_file(file, error);
-            if (exists && image == &m.map_kd) continue;
-            const std::string what = exists ? "alpha and bump maps of OBJ materials are not "
-                                              "applied yet"
-                                            : "cannot open " + file.string();
+            if (std::filesystem::is_regular_file(file, error)) continue;
             context_.warn_in(mtl_path.string(), (*image)->line,
-                             what + "; the material's constant colour is used");
+                             "cannot open " + file.string() + "; " + without(image, m));
         }
     }
 
-    // An MTL material's map_Kd through the scene's cache; null (the constant colour) when it has
-    // none, or one that cannot be read, which is a warning at its line.
-    std::shared_ptr<const MipMap> colour_map(const LibraryMaterial& m) {
-        if (!m.mtl.map_kd) return nullptr;
-        const std::filesystem::path file = m.mtl_path.parent_path() / m.mtl.map_kd->path;
+    static std::string without(const std::optional<MtlTexture>* image, const MtlMaterial& m) {
+        if (image == &m.map_d) return "the material has no cut-out";
+        if (image == &m.bump) return "the material has no bumps";
+        return "the material's constant colour is used";
+    }
+
+    // One of an MTL material's images (map_Kd, map_d, bump) through the scene's cache; null when
+    // it has none, or one that cannot be read, which is a warning at its line.
+    std::shared_ptr<const MipMap> mtl_image(const LibraryMaterial& m,
+                                            const std::optional<MtlTexture>& image,
+                                            TextureEncoding encoding) {
+        if (!image) return nullptr;
+        const std::filesystem::path file = m.mtl_path.parent_path() / image->path;
         std::error_code error;
         if (!std::filesystem::is_regular_file(file, error)) return nullptr;  // warned already
         const std::size_t before = textures_.files_read();
         try {
-            auto image = textures_.get(file, TextureEncoding::kColor);
+            auto mipmap = textures_.get(file, encoding);
             if (textures_.files_read() > before) files_read_.push_back(file);
-            return image;
+            return mipmap;
         } catch (const ImageError& e) {
-            context_.warn_in(m.mtl_path.string(), m.mtl.map_kd->line,
-                             std::string(e.what()) + "; the material's constant colour is used");
+            context_.warn_in(m.mtl_path.string(), image->line,
+                             std::string(e.what()) + "; " + without(&image, m.mtl));
             return nullptr;
         }
     }
@@ -1086,11 +1099,13 @@ class SceneReader {
             surface.height = load(surface.bump_file, TextureEncoding::kData);
     }
 
-    static std::shared_ptr<const TriangleMesh> build_mesh(const Attributes& in, ObjMesh&& obj,
-                                                          const MeshTransform& transform,
-                                                          bool smooth) {
+    static std::shared_ptr<const TriangleMesh> build_mesh(
+        const Attributes& in, ObjMesh&& obj, const MeshTransform& transform, bool smooth,
+        std::shared_ptr<const MipMap> alpha = nullptr) {
         try {
-            return std::make_shared<const TriangleMesh>(std::move(obj), transform, smooth);
+            auto mesh = std::make_shared<TriangleMesh>(std::move(obj), transform, smooth);
+            if (alpha) mesh->set_alpha(std::move(alpha));
+            return mesh;
         } catch (const std::domain_error& error) {
             in.fail(error.what());
         }

@@ -752,6 +752,50 @@ TEST_F(CliTest, AdaptiveRenderRecordsItsThresholdInTheExrHeader) {
     EXPECT_NE(header.find("samplesPerPixel (type int): 32"), std::string::npos) << header;
 }
 
+// --aov: the listed channels beside R, G and B; the image's own floats untouched; anything but
+// one .exr output refused before rendering.
+TEST_F(CliTest, AovsAreExtraExrChannelsAndOtherOutputsAreRefused) {
+    ASSERT_EQ(run({"scene.xml", "-q", "-o", "plain.exr"}).status, 0);
+    const Outcome r = run({"scene.xml", "-q", "--aov", "albedo,normal,depth", "-o", "a.exr"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(read_image(file("a.exr")).rgb, read_image(file("plain.exr")).rgb);
+    const std::string header = shell_output("exrheader " + file("a.exr").string());
+    for (const char* channel : {"albedo.R, 32", "albedo.G, 32", "albedo.B, 32", "normal.X, 32",
+                                "normal.Y, 32", "normal.Z, 32", "depth.Z, 32"}) {
+        EXPECT_NE(header.find(channel), std::string::npos) << channel << "\n" << header;
+    }
+    // The bottom-left pixel sees the grey floor (diffuse 1, kd 0.7), facing up; the top-left
+    // one sees the sky: 0 in every channel.
+    const std::size_t bottom = 15 * 24, top = 0;
+    EXPECT_EQ(read_exr_channel(file("a.exr"), "albedo.G")[bottom], 0.7f);
+    EXPECT_EQ(read_exr_channel(file("a.exr"), "normal.Y")[bottom], 1.0f);
+    EXPECT_GT(read_exr_channel(file("a.exr"), "depth.Z")[bottom], 2.0f);
+    for (const char* channel : {"albedo.R", "normal.Y", "depth.Z"}) {
+        EXPECT_EQ(read_exr_channel(file("a.exr"), channel)[top], 0.0f) << channel;
+    }
+    EXPECT_THROW(read_exr_channel(file("plain.exr"), "depth.Z"), ImageError);
+
+    const std::vector<std::pair<std::vector<std::string>, std::string>> refused = {
+        {{"scene.xml", "--aov", "albedo", "-o", "a.png"},
+         "drt: --aov needs an .exr output (-o FILE.exr): only OpenEXR holds the extra channels\n"},
+        {{"scene.xml", "--aov", "albedo"},  // scene.png
+         "drt: --aov needs an .exr output (-o FILE.exr): only OpenEXR holds the extra channels\n"},
+        {{"scene.xml", "--aov", "albedo,z", "-o", "a.exr"},
+         "drt: --aov: unknown AOV 'z' (known: albedo, normal, depth)\n"},
+        {{"scene.xml", "scene.xml", "--aov", "depth", "-o", "out/"},
+         "drt: --aov takes one scene, not a batch\n"},
+        {{"scene.xml", "--aov", "depth", "--target-error", "0.1", "-o", "a.exr"},
+         "drt: --aov excludes --target-error\n"},
+    };
+    for (const auto& [args, message] : refused) {
+        fs::remove(file("a.exr"));
+        const Outcome bad = run(args);
+        EXPECT_EQ(bad.status, 2) << args.back();
+        EXPECT_EQ(bad.err.rfind(message, 0), 0u) << bad.err;
+        EXPECT_EQ(entries(dir_), (std::vector<std::string>{"plain.exr", "scene.xml"})) << bad.err;
+    }
+}
+
 TEST_F(CompareCliTest, ExrComparesWithPfmButNotWithEightBitFiles) {
     write_image(constant(4, 3, 0.25f), file("quarter.exr"));
     const Outcome same = run({"compare", "quarter.exr", "quarter.pfm", "--max-rmse", "0"});

@@ -66,6 +66,21 @@ TEST(TextureFile, EightBitColourIsDecodedFromSrgbAndDataIsLinear) {
     }
 }
 
+// An alpha map (map_d) is the alpha channel where the image has one, linear (code / 255), and
+// otherwise the luminance of the values taken as data; all three channels hold it.
+TEST(TextureFile, AlphaIsTheAlphaChannelElseTheLuminance) {
+    const unsigned char rgba[8] = {255, 255, 255, 64, 0, 0, 0, 200};
+    Bytes with_alpha;
+    stbi_write_png_to_func(append, &with_alpha, 2, 1, 4, rgba, 8);
+    const Image a = decode(with_alpha, TextureEncoding::kAlpha);
+    EXPECT_NEAR(a.at(0, 0).r, 64 / 255.0, 1e-7);
+    EXPECT_NEAR(a.at(0, 0).b, 64 / 255.0, 1e-7);
+    EXPECT_NEAR(a.at(1, 0).g, 200 / 255.0, 1e-7);
+    const Image l = decode(encoded("png", 188, 0, 255), TextureEncoding::kAlpha);
+    EXPECT_NEAR(l.at(0, 0).r, 0.2126 * 188 / 255.0 + 0.0722, 1e-6);
+    EXPECT_NEAR(l.at(1, 0).r, 0.2126 + 0.0722 * 188 / 255.0, 1e-6);
+}
+
 TEST(TextureFile, JpegDecodesNearItsColours) {
     const Image image = decode(encoded("jpg", 188, 188, 188));
     EXPECT_NEAR(image.at(0, 0).g, 0.503, 0.02);

@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "drt/io/image.h"
 #include "drt/job/render_job.h"
 #include "drt/scene/scene_loader.h"
 #include "drt/util/atomic_file.h"
@@ -236,16 +237,38 @@ TEST_F(TempDir, APathRendersCheckpointIsFormatFiveWithDiffuseCounts) {
             << e.what();
     }
     std::vector<unsigned char> unknown = five;
-    unknown[7] = '6';
+    unknown[7] = '8';
     try {
         decode_checkpoint(unknown, grid, "c", DiffuseCount::kCarried);
-        ADD_FAILURE() << "format 6 decoded";
+        ADD_FAILURE() << "format 8 decoded";
     } catch (const CheckpointError& e) {
-        EXPECT_NE(std::string(e.what()).find("checkpoint format 6 of another drt version, this "
+        EXPECT_NE(std::string(e.what()).find("checkpoint format 8 of another drt version, this "
                                              "one reads format 5"),
                   std::string::npos)
             << e.what();
     }
+}
+
+// A render with AOVs keeps them in format 6 (7 for a path render): their count after the tile
+// count, their values after each tile's.
+TEST_F(TempDir, ARenderWithAovsKeepsThemInFormatSix) {
+    const std::vector<Tile> grid = tile_grid(40, 28);
+    RenderIdentity id = identity_of(grid);
+    const std::vector<unsigned char> four =
+        encode_checkpoint(id, std::vector{some_tile(grid[1], 1.0f)});
+    id.aov_channels = 4;
+    TileBuffer tile = some_tile(grid[1], 1.0f);
+    tile.aovs.assign(4 * tile.pixel_samples.size(), 0.5f);
+    tile.aovs.back() = -2;
+    const std::vector<unsigned char> six = encode_checkpoint(id, std::vector{tile});
+    EXPECT_EQ(six[7], '6');
+    EXPECT_EQ(six.size(), four.size() + 4 + 4 * tile.aovs.size());
+    const Checkpoint c = decode_checkpoint(six, grid, "c", DiffuseCount::kOmitted);
+    EXPECT_EQ(c.identity, id);
+    ASSERT_EQ(c.tiles.size(), 1u);
+    EXPECT_EQ(c.tiles[0].aovs, tile.aovs);
+    id.diffuse = DiffuseCount::kCarried;
+    EXPECT_EQ(encode_checkpoint(id, std::vector{tile})[7], '7');
 }
 
 // A plain render's image and ray counts, for the resumed ones to match.
@@ -386,6 +409,36 @@ TEST_F(CheckpointCli, InterruptedRunsWritePartialAndCheckpointAndTheLastOneTheSa
                            text.find('}', text.find("\"rays\"")) - text.find("\"rays\""));
     };
     EXPECT_EQ(rays("out.json"), rays("plain.json"));
+}
+
+// --aov with --checkpoint: the resumed render's AOV channels are the uninterrupted one's, and a
+// checkpoint without them does not resume a render with them.
+TEST_F(CheckpointCli, AovsAreKeptAndResumed) {
+    const std::vector<std::string> aov{"--aov", "albedo,depth"};
+    std::vector<std::string> plain_args = command("plain.exr", aov);
+    ASSERT_EQ(run(plain_args).status, 0);
+    std::vector<std::string> resumable = command("out.exr", {"--checkpoint", "c.ckpt"});
+    std::vector<std::string> stopped = resumable;
+    stopped.insert(stopped.end(), {"--stop-after-tiles", "2"});
+    ASSERT_EQ(run(stopped).status, 130);  // without AOVs
+    resumable.insert(resumable.end(), aov.begin(), aov.end());
+    const Outcome foreign = run(resumable);
+    EXPECT_EQ(foreign.status, 2);
+    EXPECT_NE(foreign.err.find("checkpoint of another render"), std::string::npos) << foreign.err;
+    fs::remove(dir_ / "c.ckpt");
+    stopped = resumable;
+    stopped.insert(stopped.end(), {"--stop-after-tiles", "2"});
+    ASSERT_EQ(run(stopped).status, 130);
+    EXPECT_EQ(read_bytes(dir_ / "c.ckpt")[7], '6');
+    const Outcome r = run(resumable);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("tiles resumed"), std::string::npos) << r.err;
+    EXPECT_EQ(read_image(dir_ / "out.exr").rgb, read_image(dir_ / "plain.exr").rgb);
+    for (const char* channel : {"albedo.R", "albedo.G", "albedo.B", "depth.Z"}) {
+        EXPECT_EQ(read_exr_channel(dir_ / "out.exr", channel),
+                  read_exr_channel(dir_ / "plain.exr", channel))
+            << channel;
+    }
 }
 
 TEST_F(CheckpointCli, DamagedTruncatedAndForeignCheckpointsExitTwoAndChangeNothing) {

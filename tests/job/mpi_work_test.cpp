@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -17,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "drt/io/image.h"
 #include "run_drt.h"
 #include "temp_folder.h"
 
@@ -228,6 +230,23 @@ TEST_F(MpiCli, CausticRenderIsTheSingleProcesssBitsAndPhotons) {
     const std::string stats = bytes("mpi.json");
     EXPECT_NE(stats.find("\"photons\": 80000,"), std::string::npos) << stats;  // 4 passes of 20000
     EXPECT_NE(stats.find("\"caustics\": true"), std::string::npos) << stats;
+}
+
+// AOVs travel with the tiles: the leader's file has one process's channels.
+TEST_F(MpiCli, AovsAreTheSingleProcesssValues) {
+    const std::vector<std::string> options{"--spp", "4", "-q", "--aov", "albedo,normal,depth"};
+    ASSERT_EQ(run(small(kGlossy, "one.exr", options)).status, 0);
+    std::vector<std::string> args = small(kGlossy, "mpi.exr", options);
+    args.insert(args.end(), {"--threads", "1"});
+    const Outcome r = run_mpi(3, args);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(read_image(dir_ / "mpi.exr").rgb, read_image(dir_ / "one.exr").rgb);
+    for (const char* channel :
+         {"albedo.R", "albedo.G", "albedo.B", "normal.X", "normal.Y", "normal.Z", "depth.Z"}) {
+        const std::vector<float> one = read_exr_channel(dir_ / "one.exr", channel);
+        EXPECT_EQ(read_exr_channel(dir_ / "mpi.exr", channel), one) << channel;
+        EXPECT_TRUE(std::any_of(one.begin(), one.end(), [](float v) { return v != 0; })) << channel;
+    }
 }
 
 TEST_F(MpiCli, TargetErrorGivesTheSingleProcesssBits) {

@@ -57,6 +57,20 @@ TEST(TileCodec, ATileComesBackWithEveryBitAndCount) {
     EXPECT_EQ(got.converged, 2u);
 }
 
+// A render with AOVs: each pixel's values follow the layout without them, exactly.
+TEST(TileCodec, AovsTravelAfterTheTileAndOnlyWhenTheLayoutHasThem) {
+    const std::vector<Tile> grid = tile_grid(40, 28);
+    TileBuffer sent = filled_tile(grid[2]);
+    const std::size_t without = encode_tile(sent, DiffuseCount::kOmitted).size();
+    sent.aovs.resize(7 * sent.pixel_samples.size());
+    for (std::size_t i = 0; i < sent.aovs.size(); ++i) sent.aovs[i] = float(i) * 0.125f - 3;
+    const std::vector<unsigned char> bytes = encode_tile(sent, DiffuseCount::kOmitted, 7);
+    EXPECT_EQ(bytes.size(), without + 4 * sent.aovs.size());
+    EXPECT_EQ(decode_tile(bytes, grid, DiffuseCount::kOmitted, 7).aovs, sent.aovs);
+    EXPECT_THROW(encode_tile(sent, DiffuseCount::kOmitted), std::invalid_argument);
+    EXPECT_THROW(decode_tile(bytes, grid, DiffuseCount::kOmitted, 8), TileCodecError);
+}
+
 TEST(TileCodec, ATruncatedMessageIsTheCodecsErrorNotACheckpoints) {
     const std::vector<Tile> grid = tile_grid(40, 28);
     const std::vector<unsigned char> bytes =

@@ -2,7 +2,9 @@
 #include <gtest/gtest.h>
 #include <stb_image_write.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -146,6 +148,106 @@ TEST_F(ObjMaterialsRender, CornersWithoutVtAreAtTheOrigin) {
     const Image image = render_file(dir_ / "s.xml");
     for (const int x : {2, 5}) {
         for (const int y : {2, 5}) expect_rgb(image.at(x, y), 0.5, 0.5, 0.5);
+    }
+}
+
+// A 16 x 16 mask, left half (u < ½) one value, right half another: as the alpha channel of a
+// red RGBA image, or as the grey level of an image without alpha (then its luminance counts).
+void write_half_mask(const std::filesystem::path& path, bool with_alpha) {
+    constexpr int kSize = 16;
+    std::vector<unsigned char> pixels;
+    for (int y = 0; y < kSize; ++y) {
+        for (int x = 0; x < kSize; ++x) {
+            const unsigned char on = x < kSize / 2 ? 0 : 255;
+            if (with_alpha) {
+                pixels.insert(pixels.end(), {255, 0, 0, on});
+            } else {
+                pixels.push_back(on);
+            }
+        }
+    }
+    const int channels = with_alpha ? 4 : 1;
+    ASSERT_TRUE(
+        stbi_write_png(path.c_str(), kSize, kSize, channels, pixels.data(), channels * kSize));
+}
+
+// A red quad at y = 1 over x, z in [-1, 1], its u along +x, above a white floor, seen from
+// straight above, lit by a point light at (0, 3, 0) and ambient 0.1. With `map_d`, the quad's
+// half u < ½ is cut out.
+std::string cut_out_scene(bool with_map_d) {
+    return std::string("<Scene><Image Width=\"16\" Height=\"16\"/><Render Samples=\"1\"/>\n") +
+           "<Ambient r=\"0.1\" g=\"0.1\" b=\"0.1\"/><Materials><White diffuse=\"1\" "
+           "kdr=\"1\" kdg=\"1\" kdb=\"1\"/></Materials>\n"
+           "<Camera Ex=\"0\" Ey=\"5\" Ez=\"0\" Lx=\"0\" Ly=\"0\" Lz=\"0\" Ux=\"0\" Uy=\"0\" "
+           "Uz=\"1\" Fov=\"40\"/>\n<Light Px=\"0\" Py=\"3\" Pz=\"0\"/>\n"
+           "<Plane Px=\"0\" Py=\"0\" Pz=\"0\" Vu=\"0\" Vv=\"1\" Vw=\"0\" Material=\"White\"/>\n"
+           "<Mesh File=\"" +
+           (with_map_d ? "cut.obj" : "solid.obj") + "\" Smooth=\"0\"/></Scene>\n";
+}
+
+constexpr std::string_view kLevelQuad =
+    "v -1 1 1\nv 1 1 1\nv 1 1 -1\nv -1 1 -1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n";
+
+// Cut-outs: camera rays see the floor through the quad's cut-out half and the quad elsewhere,
+// and shadow rays pass through it too: the floor beside the quad is lit beyond its cut-out half
+// and in shadow beyond its solid half. Alpha from the alpha channel, or from the luminance.
+TEST_F(ObjMaterialsRender, MapDCutsOutWhereAlphaIsBelowAHalfForEveryRay) {
+    write("solid.obj", std::string(kLevelQuad) + "mtllib m.mtl\nusemtl solid\nf 1/1 2/2 3/3 4/4\n");
+    write("cut.obj", std::string(kLevelQuad) + "mtllib m.mtl\nusemtl cut\nf 1/1 2/2 3/3 4/4\n");
+    write("solid.xml", cut_out_scene(false));
+    write("cut.xml", cut_out_scene(true));
+    for (const bool with_alpha : {true, false}) {
+        write_half_mask(dir_ / "mask.png", with_alpha);
+        write("m.mtl", "newmtl solid\nKd 1 0 0\nnewmtl cut\nKd 1 0 0\nmap_d mask.png\n");
+        const LoadedScene loaded = load_scene(dir_ / "cut.xml");
+        EXPECT_TRUE(loaded.warnings.empty()) << loaded.warnings.front();
+        const Image solid = render_file(dir_ / "solid.xml"), cut = render_file(dir_ / "cut.xml");
+        // Pixels 2 and 13 of row 8 look at the floor at x = ±1.25, beside the quad; pixels 5
+        // and 10 at the quad's two halves (x = ±0.57).
+        const auto lit = [](const Color& c) { return c.g > 0.9; };
+        EXPECT_NEAR(solid.at(2, 8).g, 0.1, 1e-6);  // the whole quad's shadow
+        EXPECT_NEAR(solid.at(13, 8).g, 0.1, 1e-6);
+        EXPECT_NEAR(solid.at(5, 8).g, 0, 1e-9);  // red quad
+        EXPECT_NEAR(solid.at(10, 8).g, 0, 1e-9);
+        // One side lit through the holes, the other in the solid half's shadow.
+        EXPECT_TRUE(lit(cut.at(2, 8)) != lit(cut.at(13, 8))) << with_alpha;
+        EXPECT_NEAR(std::min(cut.at(2, 8).g, cut.at(13, 8).g), 0.1, 1e-6);
+        // Through the cut-out half the lit floor, on the same side as the lit floor beside it.
+        const bool left_cut = lit(cut.at(2, 8));
+        EXPECT_TRUE(lit(cut.at(left_cut ? 5 : 10, 8))) << with_alpha;
+        EXPECT_NEAR(cut.at(left_cut ? 10 : 5, 8).g, 0, 1e-9) << with_alpha;
+        EXPECT_GT(cut.at(left_cut ? 10 : 5, 8).r, 0.9) << with_alpha;
+    }
+}
+
+// An MTL bump map with -bm: a height ramp h = u (one unit of height over the image) with
+// strength 0.5 tilts a quad's normal (+z) against the slope: n = normalize((0, 0, 1) − 0.5 ·
+// slope · (1, 0, 0)), read back from the normal AOV at the quad's middle.
+TEST_F(ObjMaterialsRender, MtlBumpMapTiltsTheNormalAsTheRampPredicts) {
+    constexpr int kWidth = 64;
+    std::vector<unsigned char> ramp;
+    for (int y = 0; y < 4; ++y) {
+        for (int x = 0; x < kWidth; ++x) ramp.push_back(static_cast<unsigned char>(4 * x));
+    }
+    ASSERT_TRUE(stbi_write_png((dir_ / "ramp.png").c_str(), kWidth, 4, 1, ramp.data(), kWidth));
+    write("m.obj", std::string(kUvQuad) + "mtllib m.mtl\nusemtl bumpy\nf 1/1 2/2 3/3 4/4\n");
+    write("m.mtl", "newmtl bumpy\nKd 1 1 1\nbump -bm 0.5 ramp.png\n");
+    write("s.xml", uv_scene(""));
+    const Scene scene = load_scene(dir_ / "s.xml").scene;
+    RenderRequest request = RenderRequest::whole_image(scene.settings);
+    request.aovs = {Aov::kNormal};
+    RenderOptions options;
+    options.threads = 1;
+    const RenderResult r = render(scene, request, options);
+    const double slope = 4.0 / 255 * kWidth;  // height per unit of u
+    const double tilt = 0.5 * slope, norm = std::sqrt(1 + tilt * tilt);
+    for (const int x : {3, 4}) {
+        for (const int y : {3, 4}) {
+            const float* n = r.aovs.data() + 3 * (8 * y + x);
+            EXPECT_NEAR(n[0], -tilt / norm, 2e-3) << x << "," << y;
+            EXPECT_NEAR(n[1], 0, 2e-3);
+            EXPECT_NEAR(n[2], 1 / norm, 2e-3);
+        }
     }
 }
 

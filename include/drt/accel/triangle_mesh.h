@@ -8,6 +8,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <type_traits>
@@ -18,6 +19,7 @@
 #include "drt/geometry/mesh_transform.h"
 #include "drt/geometry/triangle.h"
 #include "drt/io/obj_reader.h"
+#include "drt/shading/mipmap.h"
 #include "drt/util/math.h"
 #include "drt/util/ray.h"
 
@@ -52,6 +54,13 @@ class TriangleMesh {
     const Vec3& origin() const { return origin_; }
     // Bounds in the mesh's own coordinates.
     Bounds bounds() const { return tree_.bounds(); }
+
+    // An alpha cut-out (an MTL map_d): a point whose alpha (the map's first channel, bilinear at
+    // the point's (u, v)) is below ½ is not there, and every ray, shadow rays included, passes
+    // it. A mesh without one runs the queries exactly as before.
+    void set_alpha(std::shared_ptr<const MipMap> alpha) { alpha_ = std::move(alpha); }
+    bool has_alpha() const { return alpha_ != nullptr; }
+    bool opaque(std::uint32_t triangle, const Barycentrics& b) const;
 
     // Nearest hit inside `range` of a ray given in the mesh's own coordinates.
     std::optional<MeshHit> intersect(const Ray& ray, Interval range) const;
@@ -107,7 +116,8 @@ class TriangleMesh {
     template <bool kAnyHit>
     using Answer = std::conditional_t<kAnyHit, bool, std::optional<MeshHit>>;
     // The query (mesh_traversal.cpp); `tests`, when given, counts the triangles tested.
-    template <bool kAnyHit>
+    // kAlpha: hits on cut-out points are passed over (set_alpha).
+    template <bool kAnyHit, bool kAlpha = false>
     Answer<kAnyHit> traverse(const Ray& ray, Interval range, std::uint64_t* tests = nullptr) const;
 
     Vec3 origin_;
@@ -117,6 +127,7 @@ class TriangleMesh {
     // Per triangle, its corners' (u, v) in single precision; empty when the file has no `vt`.
     std::vector<std::array<float, 6>> texcoords_;
     MeshTree tree_;
+    std::shared_ptr<const MipMap> alpha_;  // null: no cut-outs
     std::size_t dropped_ = 0;
     std::size_t collapsed_ = 0;
 };

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "drt/io/image.h"
@@ -18,5 +19,10 @@ std::vector<unsigned char> encode_exr(const Image& image, const ImageWriteOption
 // memory, whatever their stored type. Anything OpenEXR cannot read becomes an ImageError that
 // names `path`.
 Image decode_exr(const std::vector<unsigned char>& data, const std::filesystem::path& path);
+
+// One named channel (such as "depth.Z") of the first part, row by row, as floats; an ImageError
+// naming `path` if the file has no such channel.
+std::vector<float> decode_exr_channel(const std::vector<unsigned char>& data,
+                                      const std::string& name, const std::filesystem::path& path);
 
 }  // namespace drt

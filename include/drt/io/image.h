@@ -42,9 +42,17 @@ struct ImageAttribute {
     std::variant<std::string, int, double> value;
 };
 
+// Channels besides R, G and B, which only .exr files hold: `names.size()` values a pixel, row by
+// row, in the order of `names` (such as "albedo.R").
+struct ExtraChannels {
+    std::vector<std::string> names;
+    std::vector<float> values;
+};
+
 struct ImageWriteOptions {
     bool half = false;  // .exr: 16-bit half floats instead of 32-bit floats
     std::vector<ImageAttribute> attributes;
+    ExtraChannels extra;  // .exr only: another format with extra channels is refused
 };
 
 // A file that cannot be read, written or understood; the message names the file.
@@ -69,5 +77,8 @@ void write_image(const Image& image, const std::filesystem::path& path,
 
 // Reads .png/.bmp as stored values / 255 (still sRGB-encoded), .pfm and .exr as their floats.
 Image read_image(const std::filesystem::path& path);
+
+// One named channel of an .exr file (such as "albedo.R"), row by row.
+std::vector<float> read_exr_channel(const std::filesystem::path& path, const std::string& name);
 
 }  // namespace drt

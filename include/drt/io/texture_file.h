@@ -12,7 +12,9 @@ namespace drt {
 
 // How an image's 8- or 16-bit values are meant: colours are sRGB-encoded (decoded to linear),
 // data such as a height map is linear already. HDR and EXR files hold linear floats either way.
-enum class TextureEncoding { kColor, kData };
+// An alpha map (MTL map_d) is the image's alpha channel where it has one, else the luminance of
+// its linear values, in all three channels.
+enum class TextureEncoding { kColor, kData, kAlpha };
 
 // Decodes a texture file held in memory into linear RGB (row 0 at the top), its pixels refused
 // past kMaxPixels from the header alone, before anything is allocated for them. Throws

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "drt/job/tile_codec.h"
+#include "drt/render/aov.h"
 #include "drt/render/renderer.h"
 #include "drt/render/tile.h"
 #include "drt/scene/scene.h"
@@ -48,6 +49,9 @@ struct RenderIdentity {
     std::uint64_t tiles = 0;  // how many tiles the image is cut into
     // Whether its tiles count diffuse rays: the file's format (4 without, 5 with).
     DiffuseCount diffuse = DiffuseCount::kOmitted;
+    // The AOV values each pixel of a tile carries (--aov): formats 6 (without diffuse counts)
+    // and 7 (with) hold them; 0 keeps formats 4 and 5.
+    std::uint32_t aov_channels = 0;
 
     friend bool operator==(const RenderIdentity&, const RenderIdentity&) = default;
 };
@@ -60,8 +64,8 @@ std::uint64_t hash_bytes(std::span<const unsigned char> bytes);
 // are not part of the identity.
 RenderIdentity identify_render(std::span<const std::filesystem::path> files,
                                const RenderSettings& settings,
-                               const std::optional<AdaptiveSampling>& adaptive,
-                               std::uint64_t tiles);
+                               const std::optional<AdaptiveSampling>& adaptive, std::uint64_t tiles,
+                               std::span<const Aov> aovs = {});
 
 struct Checkpoint {
     RenderIdentity identity;

@@ -37,17 +37,21 @@ enum class DiffuseCount { kOmitted, kCarried };
 // The layout of the tiles of a render with these settings.
 DiffuseCount diffuse_count_for(const RenderSettings& settings);
 
-// Appends `tile`'s bytes to `bytes`. Omitting the diffuse count requires it to be 0.
-void append_tile(std::vector<unsigned char>& bytes, const TileBuffer& tile, DiffuseCount diffuse);
-std::vector<unsigned char> encode_tile(const TileBuffer& tile, DiffuseCount diffuse);
+// Appends `tile`'s bytes to `bytes`. Omitting the diffuse count requires it to be 0. A render
+// with AOVs (aov.h) appends each pixel's `aov_channels` values, which the tile must hold; the
+// layout without them is unchanged.
+void append_tile(std::vector<unsigned char>& bytes, const TileBuffer& tile, DiffuseCount diffuse,
+                 std::size_t aov_channels = 0);
+std::vector<unsigned char> encode_tile(const TileBuffer& tile, DiffuseCount diffuse,
+                                       std::size_t aov_channels = 0);
 
 // Decodes the tile at the front of `bytes` and drops its bytes from the view. The tile must be
 // one of `grid` not yet marked in `seen` (grid.size() flags), which it then marks.
 TileBuffer take_tile(std::span<const unsigned char>& bytes, std::span<const Tile> grid,
-                     std::vector<bool>& seen, DiffuseCount diffuse);
+                     std::vector<bool>& seen, DiffuseCount diffuse, std::size_t aov_channels = 0);
 
 // A message of exactly one tile of `grid`.
 TileBuffer decode_tile(std::span<const unsigned char> bytes, std::span<const Tile> grid,
-                       DiffuseCount diffuse);
+                       DiffuseCount diffuse, std::size_t aov_channels = 0);
 
 }  // namespace drt

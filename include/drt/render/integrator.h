@@ -42,6 +42,11 @@ Vec3 reflect_above(const Vec3& d, const Vec3& shading, const Vec3& geometric);
 std::optional<Vec3> refract_below(const Vec3& d, const Vec3& shading, const Vec3& geometric,
                                   double eta);
 
+// The surface at a hit. A camera ray (depth 0) filters image textures over the footprint of one
+// of its pixel's `samples` camera samples; deeper rays, whose spread the camera does not know,
+// read the finest level.
+SurfaceHit surface_of(const Ray& ray, const Hit& hit, int depth, const Camera& camera, int samples);
+
 class Integrator final : public PixelIntegrator {
   public:
     // With `photons`, diffuse parts add the caustic light the photon maps estimate.

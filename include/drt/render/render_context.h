@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "drt/accel/bvh.h"
+#include "drt/render/aov.h"
 #include "drt/render/pixel_integrator.h"
 #include "drt/render/render_plan.h"
 #include "drt/render/render_request.h"
@@ -116,6 +117,7 @@ class RenderContext {
     std::unique_ptr<const PhotonMaps> photons_;
     // The integrator the scene names (make_integrator), over each plan.
     std::unique_ptr<const PixelIntegrator> area_integrator_, centre_integrator_;
+    AovTracer area_aovs_, centre_aovs_;  // the camera rays of each plan
     std::vector<Tile> tiles_;
 };
 

@@ -8,6 +8,7 @@
 #include <optional>
 #include <vector>
 
+#include "drt/render/aov.h"
 #include "drt/scene/scene.h"
 
 namespace drt {
@@ -47,6 +48,9 @@ struct RenderRequest {
     // then a quarter of the pair's squared difference, whose expectation is the variance of their
     // mean whatever the sampler, so the estimate is the pixels' own and needs no calibration.
     bool paired = false;
+    // First-hit values each rendered pixel also gets (aov.h): the mean over as many camera
+    // samples as the pixel took, the first ones of its pattern.
+    std::vector<Aov> aovs;
 
     // The whole image at the settings' samples and seed.
     static RenderRequest whole_image(const RenderSettings& settings) {

@@ -68,6 +68,9 @@ struct RenderResult {
     // The spread of each pixel's samples, per channel: times stats.error.scale, the variance of
     // the pixel's mean.
     Image spread;
+    // The request's AOVs (aov.h): aov_channel_count values a pixel, row by row.
+    std::vector<Aov> aov_list;
+    std::vector<float> aovs;
     // Tiles not rendered because a stop was requested (their pixels are 0); empty otherwise.
     std::vector<Tile> unfinished;
 };

@@ -46,6 +46,8 @@ struct TileBuffer {
     RayCounts rays;
     std::uint64_t samples = 0;    // camera samples over the tile's pixels
     std::uint64_t converged = 0;  // adaptive: pixels that stopped before the maximum
+    // The request's AOVs: aov_channel_count values a pixel, row by row; empty without them.
+    std::vector<float> aovs;
 };
 
 // Hands out tiles to render. next() is called from several worker threads at once and returns
@@ -91,7 +93,8 @@ class TileQueue final : public TileSource {
 // twice.
 class ImageSink final : public TileSink {
   public:
-    ImageSink(int width, int height, std::vector<Tile> grid);
+    // `aov_channels`: the AOV values each pixel of a tile carries (aov.h), 0 for none.
+    ImageSink(int width, int height, std::vector<Tile> grid, std::size_t aov_channels = 0);
 
     void add(TileBuffer buffer) override;
 
@@ -104,6 +107,7 @@ class ImageSink final : public TileSink {
     const Image& image() const { return image_; }
     const std::vector<std::uint32_t>& pixel_samples() const { return pixel_samples_; }
     const Image& spread() const { return spread_; }
+    const std::vector<float>& aovs() const { return aovs_; }  // per pixel, row by row
     // Added up in tile order, so the same whatever order the tiles came in.
     ErrorSums error_sums() const;
     const RayCounts& rays() const { return rays_; }
@@ -115,6 +119,8 @@ class ImageSink final : public TileSink {
     Image image_;
     std::vector<std::uint32_t> pixel_samples_;
     Image spread_;
+    std::size_t aov_channels_;
+    std::vector<float> aovs_;
     std::vector<ErrorSums> error_sums_;  // by tile index
     RayCounts rays_;
     std::uint64_t samples_ = 0, converged_ = 0;
