@@ -18,7 +18,7 @@ constexpr int kWidth = 800, kHeight = 600;
 
 // A tile's buffer with every field filled, as a 100-sample render leaves it.
 TileBuffer full_tile(const Tile& t) {
-    TileBuffer b{t, Image(t.width(), t.height()), {}, Image(t.width(), t.height()), {}, {}, 0, 0};
+    TileBuffer b{t, Image(t.width(), t.height()), {}, Image(t.width(), t.height()), {}, {}, 0, 0, {}};
     for (int y = 0; y < t.height(); ++y) {
         for (int x = 0; x < t.width(); ++x) {
             const float v = float(t.index % 97) / 97.0F + float(x * y) * 1e-4F;
@@ -37,7 +37,7 @@ struct Messages {
     std::vector<Tile> grid = tile_grid(kWidth, kHeight);
     std::vector<std::vector<unsigned char> > encoded;
     Messages() {
-        for (const Tile& t : grid) encoded.push_back(encode_tile(full_tile(t)));
+        for (const Tile& t : grid) encoded.push_back(encode_tile(full_tile(t), DiffuseCount::kOmitted));
     }
 };
 
@@ -45,7 +45,7 @@ void BM_TileMessageDecode(benchmark::State& state) {
     const Messages m;
     std::size_t i = 0;
     for (auto _ : state) {
-        benchmark::DoNotOptimize(decode_tile(m.encoded[i], m.grid));
+        benchmark::DoNotOptimize(decode_tile(m.encoded[i], m.grid, DiffuseCount::kOmitted));
         i = (i + 1) % m.grid.size();
     }
     state.SetBytesProcessed(std::int64_t(state.iterations()) * std::int64_t(m.encoded[0].size()));
@@ -63,7 +63,7 @@ void BM_TileMessageDecodeAndAssemble(benchmark::State& state) {
             sink.emplace(kWidth, kHeight, m.grid);
             state.ResumeTiming();
         }
-        sink->add(decode_tile(m.encoded[i], m.grid));
+        sink->add(decode_tile(m.encoded[i], m.grid, DiffuseCount::kOmitted));
         i = (i + 1) % m.grid.size();
     }
 }
