@@ -230,6 +230,7 @@ class LeaderQueue final : public TileSource {
         const std::lock_guard lock(mutex_);
         tiles_.insert(tiles_.begin(), tiles.begin(), tiles.end());
     }
+    void give_back(const Tile& tile) override { give_back(std::vector<Tile>{tile}); }
     bool empty() const {
         const std::lock_guard lock(mutex_);
         return tiles_.empty();
@@ -341,6 +342,11 @@ class WorkerQueue final : public TileSource {
             if (tiles.empty()) dry_ = true;
         }
         ready_.notify_all();
+    }
+    // A tile a stop made a worker abandon: drained with those not taken.
+    void give_back(const Tile& tile) override {
+        const std::lock_guard lock(mutex_);
+        tiles_.push_front(tile);
     }
     // What was handed over but not taken: to give back to the leader.
     std::vector<Tile> drain() {

@@ -196,6 +196,11 @@ std::vector<std::size_t> RenderContext::rendered_in(const Tile& tile,
 }
 
 TileBuffer RenderContext::render_tile(const Tile& tile, const RenderRequest& request) const {
+    return *render_tile(tile, request, std::stop_token{});
+}
+
+std::optional<TileBuffer> RenderContext::render_tile(const Tile& tile, const RenderRequest& request,
+                                                     const std::stop_token& stop) const {
     TileBuffer buffer{tile, Image(tile.width(), tile.height()),
                       {},   Image(tile.width(), tile.height()),
                       {},   {},
@@ -206,6 +211,7 @@ TileBuffer RenderContext::render_tile(const Tile& tile, const RenderRequest& req
     std::vector<Pixel> pixels(width * static_cast<std::size_t>(tile.height()));
     const std::vector<std::size_t> rendered = rendered_in(tile, request);
     for (const std::size_t i : rendered) {
+        if (stop.stop_requested()) return std::nullopt;
         pixels[i] = render_pixel(request, tile.x0 + static_cast<int>(i % width),
                                  tile.y0 + static_cast<int>(i / width), 0, scratch, buffer.rays);
     }
@@ -233,10 +239,12 @@ TileBuffer RenderContext::render_tile(const Tile& tile, const RenderRequest& req
         }
     }
     if (request.paired) {
-        render_again(request, tile, pixels, rendered, scratch, buffer);
+        if (!render_again(request, tile, pixels, rendered, scratch, buffer, stop)) {
+            return std::nullopt;
+        }
     } else if (request.estimate_error && spread_kind(request) == SpreadKind::kCalibrated &&
                request.samples >= 2) {
-        calibrate(request, tile, pixels, rendered, scratch, buffer);
+        if (!calibrate(request, tile, pixels, rendered, scratch, buffer, stop)) return std::nullopt;
     }
     return buffer;
 }
@@ -267,9 +275,10 @@ std::uint64_t RenderContext::tile_cost(const Tile& tile, const RenderRequest& re
 // own, which every sampler folds into every number it draws.
 constexpr std::uint64_t kSecondRenderPath = 0xca11b4a7e5eedULL;
 
-void RenderContext::calibrate(const RenderRequest& request, const Tile& tile,
+bool RenderContext::calibrate(const RenderRequest& request, const Tile& tile,
                               std::span<const Pixel> pixels, std::span<const std::size_t> rendered,
-                              Scratch& scratch, TileBuffer& buffer) const {
+                              Scratch& scratch, TileBuffer& buffer,
+                              const std::stop_token& stop) const {
     // One pixel per block: every one twice, so that the estimate is their own mean squared
     // difference; a scale taken from some of them times the spreads of all follows a pixel's
     // error too loosely at few samples.
@@ -286,18 +295,21 @@ void RenderContext::calibrate(const RenderRequest& request, const Tile& tile,
         const int y = tile.y0 + static_cast<int>(i / width);
         const auto pixel = static_cast<std::uint32_t>(y * scene_.settings.width + x);
         if (to_unit(hash_of(request.seed, pixel, kSecondRenderPath)) >= odds[i]) continue;
+        if (stop.stop_requested()) return false;
         const Pixel again = render_pixel(request, x, y, kSecondRenderPath, scratch, rays);
         add_calibration(buffer.error_sums, pixels[i].value, again.value, pixels[i].spread, odds[i],
                         again.samples);
     }
+    return true;
 }
 
-void RenderContext::render_again(const RenderRequest& request, const Tile& tile,
+bool RenderContext::render_again(const RenderRequest& request, const Tile& tile,
                                  std::span<const Pixel> pixels,
                                  std::span<const std::size_t> rendered, Scratch& scratch,
-                                 TileBuffer& buffer) const {
+                                 TileBuffer& buffer, const std::stop_token& stop) const {
     const auto width = static_cast<std::size_t>(tile.width());
     for (const std::size_t i : rendered) {
+        if (stop.stop_requested()) return false;
         const int x = static_cast<int>(i % width), y = static_cast<int>(i / width);
         const Pixel again = render_pixel(request, tile.x0 + x, tile.y0 + y, kSecondRenderPath,
                                          scratch, buffer.rays);
@@ -309,6 +321,7 @@ void RenderContext::render_again(const RenderRequest& request, const Tile& tile,
         buffer.pixel_samples[i] += again.samples;
         buffer.samples += again.samples;
     }
+    return true;
 }
 
 RenderContext::Pixel RenderContext::render_pixel(const RenderRequest& request, int x, int y,

@@ -34,7 +34,12 @@ int render_tiles(const RenderContext& context, const RenderRequest& request, Til
             while (!failed.load(std::memory_order_relaxed) && !options.stop.stop_requested()) {
                 const std::optional<Tile> tile = source.next();
                 if (!tile) break;
-                sink.add(context.render_tile(*tile, request));
+                std::optional<TileBuffer> done = context.render_tile(*tile, request, options.stop);
+                if (!done) {
+                    source.give_back(*tile);
+                    break;
+                }
+                sink.add(std::move(*done));
                 tiles_done.fetch_add(1, std::memory_order_relaxed);
             }
         },

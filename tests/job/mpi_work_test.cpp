@@ -420,5 +420,25 @@ TEST_F(MpiCli, AKilledProcessLeavesNoOutputAndTheRerunCompletesTheSameBits) {
     }
 }
 
+TEST_F(MpiCli, AWorkerStoppedOnItsOwnGivesBackTheTileInHandAndTheLeaderFinishesTheSameBits) {
+    // Path tracing at 256 spp: a tile takes about a second, so the signal finds the worker
+    // inside one, which it abandons between two pixels and gives back with those it holds.
+    const std::string cornell = (kSource / "scenes/gi/cornell-box.xml").string();
+    const std::vector<std::string> more{"--spp", "256", "--threads", "1"};
+    ASSERT_EQ(run(small(cornell, "plain.pfm", more)).status, 0);
+    std::vector<std::string> args = small(cornell, "out.pfm", more);
+    args.insert(args.end(), {"--checkpoint", "c.ckpt", "--checkpoint-every", "0"});
+    const pid_t mpirun_pid = start_process(mpirun(2, args), dir_);
+    for (int i = 0; i < 6000 && !fs::exists(dir_ / "c.ckpt"); ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    const std::vector<pid_t> pids = ranks_of(mpirun_pid, 1);
+    ASSERT_EQ(pids.size(), 1u);
+    kill(pids[0], SIGTERM);
+    const Outcome r = finish_process(mpirun_pid, dir_);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(bytes("out.pfm"), bytes("plain.pfm"));
+}
+
 }  // namespace
 }  // namespace drt

@@ -177,7 +177,8 @@ TEST(Renderer, AStopLeavesWholeTilesDoneAndTheRestUntouched) {
     options.stop = stop.get_token();
     render_tiles(context, request, source, stopping, options);
 
-    // The other worker finishes the tile it holds when the stop comes, and takes no other.
+    // The other worker abandons the tile it holds when the stop comes (unless it finished it
+    // first), and takes no other.
     const std::vector<Tile> missing = sink.missing();
     const std::size_t done = context.tiles().size() - missing.size();
     EXPECT_GE(done, 3u);
@@ -213,6 +214,77 @@ TEST(Renderer, AStopBeforeTheStartRendersNothingAndSaysSo) {
     EXPECT_EQ(r.stats.samples, 0u);
     EXPECT_TRUE(
         std::all_of(r.image.rgb.begin(), r.image.rgb.end(), [](float v) { return v == 0; }));
+}
+
+// Hands out the tiles of `tiles` one by one, requesting a stop right after handing out the
+// `stop_at`-th (1-based), and records the tiles given back.
+class StopWhileHandingOut final : public TileSource {
+  public:
+    StopWhileHandingOut(std::vector<Tile> tiles, std::stop_source stop, std::size_t stop_at)
+        : queue_(std::move(tiles)), stop_(std::move(stop)), stop_at_(stop_at) {}
+    std::optional<Tile> next() override {
+        std::optional<Tile> t = queue_.next();
+        if (t && ++handed_ == stop_at_) stop_.request_stop();
+        return t;
+    }
+    std::size_t size() const override { return queue_.size(); }
+    void give_back(const Tile& tile) override { given_back.push_back(tile); }
+
+    std::vector<Tile> given_back;
+
+  private:
+    TileQueue queue_;
+    std::stop_source stop_;
+    std::size_t stop_at_;
+    std::size_t handed_ = 0;
+};
+
+TEST(Renderer, ATileInHandWhenTheStopComesIsAbandonedAndGivenBack) {
+    const Scene scene = small_scene("thesis/test6.xml", 72);
+    const RenderContext context(scene);
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
+    ImageSink sink(scene.settings.width, scene.settings.height, context.tiles());
+    std::stop_source stop;
+    StopWhileHandingOut source(context.tiles(), stop, 2);
+    RenderOptions options = on_threads(1);
+    options.stop = stop.get_token();
+    render_tiles(context, request, source, sink, options);
+    ASSERT_EQ(source.given_back.size(), 1u);
+    EXPECT_EQ(source.given_back[0], context.tiles()[1]);
+    EXPECT_EQ(sink.tiles_done(), 1u);
+    expect_same_counts(sink.rays(), context.render_tile(context.tiles()[0], request).rays);
+}
+
+// A point light whose first sample requests a stop: the tile is left between two pixels.
+class StoppingLight final : public Light {
+  public:
+    explicit StoppingLight(std::stop_source stop)
+        : Light({1, 1, 1}, false), stop_(std::move(stop)) {}
+    using Light::sample;
+    LightSample sample(const Vec3& x, Vec2) const override {
+        stop_.request_stop();
+        const Vec3 to = Vec3{0, 100, 0} - x;
+        return {normalize(to), length(to)};
+    }
+    Ball extent() const override { return {{0, 100, 0}, 0}; }
+    bool is_point() const override { return true; }
+    std::optional<double> intersect(const Ray&, Interval) const override { return std::nullopt; }
+
+  private:
+    mutable std::stop_source stop_;
+};
+
+TEST(Renderer, AStopInsideATileAbandonsItBeforeItsNextPixel) {
+    Scene scene = testing::floor_scene(16, 16);
+    std::stop_source stop;
+    scene.lights.clear();
+    scene.lights.push_back(std::make_unique<StoppingLight>(stop));
+    const RenderContext context(scene);
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
+    ASSERT_EQ(context.tiles().size(), 1u);
+    EXPECT_FALSE(context.render_tile(context.tiles()[0], request, stop.get_token()));
+    // Without a stop token the same tile renders whole.
+    EXPECT_EQ(context.render_tile(context.tiles()[0], request).samples, 256u);
 }
 
 // A point light that cannot be sampled: every shading point's shadow ray throws.

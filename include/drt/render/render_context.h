@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <stop_token>
 #include <vector>
 
 #include "drt/accel/bvh.h"
@@ -56,6 +57,10 @@ class RenderContext {
 
     // Renders the pixels of `tile` that `request` picks. Safe to call from several threads.
     TileBuffer render_tile(const Tile& tile, const RenderRequest& request) const;
+    // The same, abandoned between two pixels once `stop` is requested: a tile of thousands of
+    // samples a pixel takes seconds, too long to keep a person who stopped the render waiting.
+    std::optional<TileBuffer> render_tile(const Tile& tile, const RenderRequest& request,
+                                          const std::stop_token& stop) const;
 
     // A guess at what render_tile(tile, request) costs, in shaded rays (camera, reflection and
     // refraction rays: shadow rays left out, cheap beside the shading they serve): those one camera
@@ -98,15 +103,15 @@ class RenderContext {
     std::vector<std::size_t> rendered_in(const Tile& tile, const RenderRequest& request) const;
     // Renders some of the tile's `rendered` pixels a second time for the error estimate's
     // calibration (error_estimate.h) and adds them to the buffer's error sums; `pixels` are all
-    // the tile's, row by row.
-    void calibrate(const RenderRequest& request, const Tile& tile, std::span<const Pixel> pixels,
-                   std::span<const std::size_t> rendered, Scratch& scratch,
-                   TileBuffer& buffer) const;
+    // the tile's, row by row. False if `stop` came first.
+    bool calibrate(const RenderRequest& request, const Tile& tile, std::span<const Pixel> pixels,
+                   std::span<const std::size_t> rendered, Scratch& scratch, TileBuffer& buffer,
+                   const std::stop_token& stop) const;
     // A paired request's second render of each of the tile's `rendered` pixels: averaged into
-    // the buffer's pixels, the pair's difference its spread.
-    void render_again(const RenderRequest& request, const Tile& tile, std::span<const Pixel> pixels,
-                      std::span<const std::size_t> rendered, Scratch& scratch,
-                      TileBuffer& buffer) const;
+    // the buffer's pixels, the pair's difference its spread. False if `stop` came first.
+    bool render_again(const RenderRequest& request, const Tile& tile, std::span<const Pixel> pixels,
+                      std::span<const std::size_t> rendered, Scratch& scratch, TileBuffer& buffer,
+                      const std::stop_token& stop) const;
 
     const Scene& scene_;
     std::unique_ptr<Sampler> sampler_;

@@ -28,8 +28,9 @@ struct RenderOptions {
     // For render(scene, options) alone (a request says its own): absent, every pixel takes the
     // scene's samples.
     std::optional<AdaptiveSampling> adaptive;
-    // Checked between tiles: once a stop is requested, each worker finishes the tile in hand and
-    // takes no other, so only whole tiles are done (RenderResult::unfinished lists the rest).
+    // Checked between pixels: once a stop is requested, each worker abandons the tile in hand
+    // (TileSource::give_back) and takes no other, so only whole tiles are done
+    // (RenderResult::unfinished lists the rest).
     std::stop_token stop;
 };
 

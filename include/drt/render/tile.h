@@ -59,6 +59,9 @@ class TileSource {
     virtual std::optional<Tile> next() = 0;
     // Tiles this source expects to hand out in all: caps the worker threads, scales progress.
     virtual std::size_t size() const = 0;
+    // A tile handed out and then abandoned by a stop. Left alone it is simply missing from the
+    // image (the render's unfinished tiles); a source serving another process returns it there.
+    virtual void give_back(const Tile& /*tile*/) {}
 };
 
 // Takes finished tiles. add() is called from several worker threads at once.
