@@ -128,6 +128,30 @@ Bytes encode_exr(const Image& image, const ImageWriteOptions& options, const fs:
     return file;
 }
 
+namespace {
+
+struct DataWindow {
+    Imath::Box2i box;
+    long long width, height;
+};
+
+// The file's data window, refused when empty or larger than drt reads: compression lets a small
+// file claim a huge image, so this comes before any allocation.
+template <class Fail>
+DataWindow data_window(const Imf::InputFile& in, const Fail& fail) {
+    const Imath::Box2i box = in.header().dataWindow();
+    const long long w = static_cast<long long>(box.max.x) - box.min.x + 1;
+    const long long h = static_cast<long long>(box.max.y) - box.min.y + 1;
+    if (w <= 0 || h <= 0) throw fail("bad OpenEXR data window");
+    if (w > kMaxImageSide || h > kMaxImageSide || static_cast<std::uint64_t>(w * h) > kMaxPixels) {
+        throw fail("image of " + std::to_string(w) + "x" + std::to_string(h) +
+                   " pixels exceeds the limit of " + std::to_string(kMaxPixels) + " pixels");
+    }
+    return {box, w, h};
+}
+
+}  // namespace
+
 Image decode_exr(const Bytes& data, const fs::path& path) {
     const auto fail = [&](const std::string& what) -> ImageError {
         return ImageError(printable(path.string()) + ": " + what);
@@ -137,16 +161,8 @@ Image decode_exr(const Bytes& data, const fs::path& path) {
         MemoryIStream stream(data, path);
         // No worker threads: a pool costs a thread start per file and one worker gains nothing.
         Imf::InputFile in(stream, 0);
-        const Imath::Box2i window = in.header().dataWindow();
-        const long long w = static_cast<long long>(window.max.x) - window.min.x + 1;
-        const long long h = static_cast<long long>(window.max.y) - window.min.y + 1;
-        if (w <= 0 || h <= 0) throw fail("bad OpenEXR data window");
-        // Compression lets a small file claim a huge image: refuse it before allocating.
-        if (w > kMaxImageSide || h > kMaxImageSide ||
-            static_cast<std::uint64_t>(w * h) > kMaxPixels) {
-            throw fail("image of " + std::to_string(w) + "x" + std::to_string(h) +
-                       " pixels exceeds the limit of " + std::to_string(kMaxPixels) + " pixels");
-        }
+        const DataWindow window = data_window(in, fail);
+        const long long w = window.width, h = window.height;
 
         // A file cut short can still have a readable header and offset table.
         if (!in.isComplete()) throw fail("truncated OpenEXR file");
@@ -166,11 +182,11 @@ Image decode_exr(const Bytes& data, const fs::path& path) {
         for (int c = 0; c < 3; ++c) {
             // A Y-only (luminance) image fills all three from the one channel.
             frame.insert(rgb ? names[c] : "Y", Imf::Slice::Make(Imf::FLOAT, pixels.get() + c,
-                                                                window, x_stride, y_stride));
+                                                                window.box, x_stride, y_stride));
             if (!rgb) break;
         }
         in.setFrameBuffer(frame);
-        in.readPixels(window.min.y, window.max.y);
+        in.readPixels(window.box.min.y, window.box.max.y);
         if (!rgb) {
             for (std::size_t i = 0; i < count; i += 3) pixels[i + 1] = pixels[i + 2] = pixels[i];
         }
@@ -196,22 +212,17 @@ std::vector<float> decode_exr_channel(const Bytes& data, const std::string& name
     try {
         MemoryIStream stream(data, path);
         Imf::InputFile in(stream, 0);
-        const Imath::Box2i window = in.header().dataWindow();
-        const long long w = static_cast<long long>(window.max.x) - window.min.x + 1;
-        const long long h = static_cast<long long>(window.max.y) - window.min.y + 1;
-        if (w <= 0 || h <= 0 || w > kMaxImageSide || h > kMaxImageSide ||
-            static_cast<std::uint64_t>(w * h) > kMaxPixels) {
-            throw fail("bad OpenEXR data window");
-        }
+        const DataWindow window = data_window(in, fail);
         if (!in.header().channels().findChannel(name)) {
             throw fail("OpenEXR image has no channel " + printable(name));
         }
-        std::vector<float> values(static_cast<std::size_t>(w * h));
+        std::vector<float> values(static_cast<std::size_t>(window.width * window.height));
         Imf::FrameBuffer frame;
-        frame.insert(name, Imf::Slice::Make(Imf::FLOAT, values.data(), window, sizeof(float),
-                                            sizeof(float) * static_cast<std::size_t>(w)));
+        frame.insert(name,
+                     Imf::Slice::Make(Imf::FLOAT, values.data(), window.box, sizeof(float),
+                                      sizeof(float) * static_cast<std::size_t>(window.width)));
         in.setFrameBuffer(frame);
-        in.readPixels(window.min.y, window.max.y);
+        in.readPixels(window.box.min.y, window.box.max.y);
         return values;
     } catch (const ImageError&) {
         throw;
