@@ -18,7 +18,8 @@ constexpr int kWidth = 800, kHeight = 600;
 
 // A tile's buffer with every field filled, as a 100-sample render leaves it.
 TileBuffer full_tile(const Tile& t) {
-    TileBuffer b{t, Image(t.width(), t.height()), {}, Image(t.width(), t.height()), {}, {}, 0, 0, {}};
+    TileBuffer b{t, Image(t.width(), t.height()), {}, Image(t.width(), t.height()), {}, {}, 0, 0,
+                 {}};
     for (int y = 0; y < t.height(); ++y) {
         for (int x = 0; x < t.width(); ++x) {
             const float v = float(t.index % 97) / 97.0F + float(x * y) * 1e-4F;
@@ -37,7 +38,8 @@ struct Messages {
     std::vector<Tile> grid = tile_grid(kWidth, kHeight);
     std::vector<std::vector<unsigned char> > encoded;
     Messages() {
-        for (const Tile& t : grid) encoded.push_back(encode_tile(full_tile(t), DiffuseCount::kOmitted));
+        for (const Tile& t : grid)
+            encoded.push_back(encode_tile(full_tile(t), DiffuseCount::kOmitted));
     }
 };
 
