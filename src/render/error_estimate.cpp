@@ -7,7 +7,6 @@
 #include <span>
 #include <sstream>
 #include <string>
-#include <tuple>
 #include <vector>
 
 namespace drt {
@@ -50,21 +49,34 @@ Color strata_spread(std::span<const Vec2> positions, std::span<const Color> samp
     const std::size_t rows = (n + columns - 1) / columns;
     Color sum;
     double terms = 0;
-    // (band, place along it, sample): sorted, the samples band by band (rows across x, or
-    // columns across y), each band in order along it; ties by index, so the order is a pure
-    // function of the samples.
-    auto& order = scratch.order;
+    // The samples band by band (rows across x, or columns across y), each band in order along it,
+    // ties by index, so the order is a pure function of the samples: dealt into their bands in
+    // index order, then each band (about sqrt(n) samples) sorted on its own, which costs far less
+    // than sorting all n at once.
+    auto& [band, start, order] = scratch;
+    band.resize(n);
     order.resize(n);
     const auto differences = [&](std::size_t bands, auto across, auto along) {
+        start.assign(bands + 1, 0);
         for (std::uint32_t i = 0; i < n; ++i) {
             const double t = std::max(0.0, across(positions[i])) * double(bands);
-            order[i] = {std::min(bands - 1, std::size_t(t)), along(positions[i]), i};
+            band[i] = static_cast<std::uint32_t>(std::min(bands - 1, std::size_t(t)));
+            ++start[band[i] + 1];
         }
-        std::sort(order.begin(), order.end());
-        const auto value = [&](std::size_t k) { return samples[std::get<2>(order[k])]; };
-        for (std::size_t begin = 0; begin < n;) {
-            std::size_t end = begin + 1;
-            while (end < n && std::get<0>(order[end]) == std::get<0>(order[begin])) ++end;
+        for (std::size_t b = 0; b < bands; ++b) start[b + 1] += start[b];
+        for (std::uint32_t i = 0; i < n; ++i) {
+            order[start[band[i]]++] = {along(positions[i]), i};
+        }
+        // Each band's start was advanced to the next's: shift them back.
+        for (std::size_t b = bands; b > 0; --b) start[b] = start[b - 1];
+        start[0] = 0;
+        const auto value = [&](std::size_t k) { return samples[order[k].index]; };
+        for (std::size_t b = 0; b < bands; ++b) {
+            const std::size_t begin = start[b], end = start[b + 1];
+            std::sort(order.begin() + begin, order.begin() + end,
+                      [](const StrataScratch::Entry& l, const StrataScratch::Entry& r) {
+                          return l.along < r.along || (!(r.along < l.along) && l.index < r.index);
+                      });
             if (end - begin == 2) {
                 const Color d = value(begin + 1) - value(begin);
                 sum += d * d / 2.0;
@@ -75,7 +87,6 @@ Color strata_spread(std::span<const Vec2> positions, std::span<const Color> samp
                 sum += d * d / 6.0;
                 terms += 1;
             }
-            begin = end;
         }
     };
     differences(

@@ -339,6 +339,81 @@ DRT_VECTORISED void permute_run(std::uint32_t first, std::uint32_t n, std::uint3
     for (std::size_t i = 0; i < count; ++i) out[i] = permute_rotate(out[i], n, key);
 }
 
+// The sides of the grids of single points (multi_jittered(j, k, key)) this thread drew lately,
+// by key. A pixel's camera samples are drawn one at a time, and every sample along the same
+// branch asks for the same dimensions, so drawing a grid's sides once per pixel and dimension
+// instead of once per point saves a shuffle of sqrt(k) elements a point, or two permutations
+// past kDealtUpTo. The points are the same either way: the sides are a pure function of (k, key).
+// Two-way set associative, since a path keeps some 20 dimensions in play at once.
+class RememberedGrids {
+  public:
+    struct Sides {
+        std::uint32_t key = 0, k = 0;  // k = 0: empty
+        // Past kDealtUpTo the sides are only drawn when the key comes back, since drawing them
+        // whole costs sqrt(k) permutations against two for the point itself.
+        bool drawn = false;
+        std::uint64_t jitter_key = 0;
+        Shape shape;
+        std::vector<std::uint32_t> sides;  // the m columns' places, then the n sub-columns'
+
+        std::uint32_t cell(std::uint32_t s) const {
+            return sides[s % shape.m] * shape.n + sides[shape.m + s / shape.m];
+        }
+    };
+
+    // The sides of the grid of k points keyed by `key`, or nullptr where they are not drawn
+    // (yet): then the point is worked out on its own.
+    const Sides* find(std::uint32_t k, std::uint32_t key) {
+        const std::uint32_t set = (key ^ k) & (kSets - 1);
+        auto& ways = sets_[set];
+        for (std::uint32_t w = 0; w < 2; ++w) {
+            Sides& sides = ways[w];
+            if (sides.key != key || sides.k != k) continue;
+            recent_[set] = static_cast<std::uint8_t>(w);
+            if (!sides.drawn) draw(sides);
+            return &sides;
+        }
+        const std::uint32_t w = 1u - recent_[set];
+        recent_[set] = static_cast<std::uint8_t>(w);
+        Sides& sides = ways[w];
+        sides.key = key;
+        sides.k = k;
+        sides.drawn = false;
+        if (k > kDealtUpTo) return nullptr;
+        draw(sides);
+        return &sides;
+    }
+
+  private:
+    static constexpr std::uint32_t kSets = 64;
+
+    static void draw(Sides& sides) {
+        const std::uint32_t k = sides.k, key = sides.key;
+        if (k <= kDealtUpTo) {
+            const Grid grid(k, key);
+            sides.shape = grid.shape;
+            sides.jitter_key = grid.jitter_key;
+            sides.sides.assign(grid.column.begin(), grid.column.end());
+            sides.sides.insert(sides.sides.end(), grid.sub_column.begin(), grid.sub_column.end());
+        } else {
+            const Shape shape = shape_for(k);
+            sides.shape = shape;
+            sides.jitter_key = jitter_key_of(grid_hash(key));
+            sides.sides.resize(shape.m + shape.n);
+            for (std::uint32_t c = 0; c < shape.m; ++c) {
+                sides.sides[c] = permute(c, shape.m, column_key(key));
+            }
+            for (std::uint32_t r = 0; r < shape.n; ++r) {
+                sides.sides[shape.m + r] = permute(r, shape.n, sub_column_key(key));
+            }
+        }
+        sides.drawn = true;
+    }
+
+    std::array<std::array<Sides, 2>, kSets> sets_;
+    std::array<std::uint8_t, kSets> recent_{};
+};
+
 // Labels are handled a batch at a time, so that a run of any length needs no allocation.
 constexpr std::size_t kBatch = 256;
 
@@ -359,6 +434,12 @@ void multi_jittered(std::uint32_t first, std::uint32_t k, std::uint32_t key, std
 
 Vec2 multi_jittered(std::uint32_t j, std::uint32_t k, std::uint32_t key) {
     const std::uint32_t s = permute(j, k, key * 0x51633e2du);
+    if (k > kPackedUpTo) {
+        thread_local RememberedGrids remembered;
+        if (const auto* sides = remembered.find(k, key)) {
+            return Jitter(sides->jitter_key, sides->shape).point(s, sides->cell(s));
+        }
+    }
     if (k > kDealtUpTo) {
         // Sides permuted per element: this point needs only its own column's and sub-column's
         // entries. A pixel's samples are drawn one at a time, and working out both whole sides

@@ -4,6 +4,7 @@
 #include <array>
 #include <bit>
 
+#include "drt/sampling/dimension_memo.h"
 #include "drt/util/rng.h"
 
 namespace drt {
@@ -99,9 +100,12 @@ struct SobolKeys {
 
 // One sequence per (seed, pixel, dimension, ray-tree branch).
 SobolKeys sobol_keys(const PixelSample& s, std::uint32_t dim) {
-    const std::uint64_t h = hash_of(s.seed, s.pixel, dim, s.path);
-    return {static_cast<std::uint32_t>(h), static_cast<std::uint32_t>(h >> 32),
-            static_cast<std::uint32_t>(mix64(h))};
+    thread_local DimensionMemo<SobolKeys> memo;
+    return memo.get(s, dim, [&] {
+        const std::uint64_t h = hash_of(s.seed, s.pixel, dim, s.path);
+        return SobolKeys{static_cast<std::uint32_t>(h), static_cast<std::uint32_t>(h >> 32),
+                         static_cast<std::uint32_t>(mix64(h))};
+    });
 }
 
 // Van der Corput's point is reverse_bits(i), whose nested scramble reverse_bits(flip(reverse_bits(
@@ -124,19 +128,21 @@ bool is_camera_dim(std::uint32_t dim) {
     return dim <= dim::kTime;
 }
 
-struct CameraSample {
-    std::uint32_t i;  // the shuffled index
-    std::uint64_t h;  // the pixel's camera key
-};
-
-CameraSample camera_sample(const PixelSample& s) {
-    const std::uint64_t h = hash_of(s.seed, s.pixel, s.path, 0xca3e7aULL);
-    return {nested_scramble(s.index, static_cast<std::uint32_t>(h)), h};
+// The keys of camera dimension `dim`: the pixel's index shuffle (`shuffle`) and the scrambles of
+// Sobol dimensions 2*dim (`x`) and 2*dim + 1 (`y`).
+SobolKeys camera_keys(const PixelSample& s, std::uint32_t dim) {
+    thread_local DimensionMemo<SobolKeys> memo;
+    return memo.get(s, dim, [&] {
+        const std::uint64_t h = hash_of(s.seed, s.pixel, s.path, 0xca3e7aULL);
+        const auto key = [&](std::uint64_t d) {
+            return static_cast<std::uint32_t>(mix64(h + d + 1));
+        };
+        return SobolKeys{static_cast<std::uint32_t>(h), key(2 * dim), key(2 * dim + 1)};
+    });
 }
 
-double camera_coordinate(const CameraSample& c, int d) {
-    const auto key = static_cast<std::uint32_t>(mix64(c.h + static_cast<std::uint64_t>(d) + 1));
-    return to_unit(nested_scramble(sobol(c.i, d), key));
+double camera_coordinate(std::uint32_t i, int d, std::uint32_t key) {
+    return to_unit(nested_scramble(sobol(i, d), key));
 }
 
 }  // namespace
@@ -153,16 +159,21 @@ std::uint32_t sobol(std::uint32_t i, int dimension) {
 }
 
 double SobolSampler::get_1d(const PixelSample& s, std::uint32_t dim) const {
-    if (is_camera_dim(dim)) return camera_coordinate(camera_sample(s), 2 * static_cast<int>(dim));
+    if (is_camera_dim(dim)) {
+        const SobolKeys k = camera_keys(s, dim);
+        return camera_coordinate(nested_scramble(s.index, k.shuffle), 2 * static_cast<int>(dim),
+                                 k.x);
+    }
     const SobolKeys k = sobol_keys(s, dim);
     return scrambled_x(nested_scramble(s.index, k.shuffle), k.x);
 }
 
 Vec2 SobolSampler::get_2d(const PixelSample& s, std::uint32_t dim) const {
     if (is_camera_dim(dim)) {
-        const CameraSample c = camera_sample(s);
+        const SobolKeys k = camera_keys(s, dim);
+        const std::uint32_t i = nested_scramble(s.index, k.shuffle);
         const int d = 2 * static_cast<int>(dim);
-        return {camera_coordinate(c, d), camera_coordinate(c, d + 1)};
+        return {camera_coordinate(i, d, k.x), camera_coordinate(i, d + 1, k.y)};
     }
     return sobol_point(s.index, sobol_keys(s, dim));
 }

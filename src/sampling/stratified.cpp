@@ -1,5 +1,6 @@
 #include "drt/sampling/stratified.h"
 
+#include "drt/sampling/dimension_memo.h"
 #include "drt/sampling/multi_jittered.h"
 #include "drt/util/rng.h"
 
@@ -11,9 +12,22 @@ std::uint32_t key32(std::uint64_t h) {
     return static_cast<std::uint32_t>(h ^ (h >> 32));
 }
 
-// The key of one dimension's pattern over a pixel's camera samples on one ray-tree branch.
+// What one dimension's pattern over a pixel's camera samples on one ray-tree branch derives from:
+// its key, and the hash of (seed, pixel) that its 1-D jitters continue.
+struct PatternKeys {
+    std::uint32_t key;
+    std::uint64_t pixel_hash;
+};
+
+PatternKeys pattern_keys(const PixelSample& s, std::uint32_t dim) {
+    thread_local DimensionMemo<PatternKeys> memo;
+    return memo.get(s, dim, [&] {
+        return PatternKeys{key32(hash_of(s.seed, s.pixel, dim, s.path)), hash_of(s.seed, s.pixel)};
+    });
+}
+
 std::uint32_t pattern_key(const PixelSample& s, std::uint32_t dim) {
-    return key32(hash_of(s.seed, s.pixel, dim, s.path));
+    return pattern_keys(s, dim).key;
 }
 
 // The key of one camera sample's set in one dimension of one ray-tree branch: (seed, pixel,
@@ -27,8 +41,12 @@ std::uint32_t set_key(const PixelSample& s, std::uint32_t dim) {
 }  // namespace
 
 double StratifiedSampler::get_1d(const PixelSample& s, std::uint32_t dim) const {
-    const double jitter = to_unit(hash_of(s.seed, s.pixel, s.index, dim, s.path));
-    return (permute(s.index, s.count, pattern_key(s, dim)) + jitter) / s.count;
+    const PatternKeys keys = pattern_keys(s, dim);
+    // hash_of(seed, pixel, index, dim, path), continued from the pixel's part (hash_of folds left).
+    const std::uint64_t h =
+        hash_combine(hash_combine(hash_combine(keys.pixel_hash, s.index), dim), s.path);
+    const double jitter = to_unit(h);
+    return (permute(s.index, s.count, keys.key) + jitter) / s.count;
 }
 
 Vec2 StratifiedSampler::get_2d(const PixelSample& s, std::uint32_t dim) const {

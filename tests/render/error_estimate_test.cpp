@@ -9,6 +9,7 @@
 #include <random>
 #include <span>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "drt/goal/converge.h"
@@ -62,6 +63,69 @@ TEST(StrataSpread, SecondDifferencesInBandsOfThree) {
     StrataScratch scratch;
     EXPECT_DOUBLE_EQ(strata_spread(at, samples, scratch).r, terms / 6 / 9);
     EXPECT_EQ(strata_spread(at, samples, scratch).b, 0);
+}
+
+// The spread as it was first written, sorting (band, place, index) of all samples at once:
+// strata_spread deals the samples into bands and sorts each band, which must be the same order
+// and so the same sums, bit for bit.
+Color strata_spread_by_full_sort(std::span<const Vec2> positions, std::span<const Color> samples) {
+    const std::size_t n = samples.size();
+    const auto columns = std::max<std::size_t>(1, std::size_t(std::sqrt(double(n))));
+    const std::size_t rows = (n + columns - 1) / columns;
+    Color sum;
+    double terms = 0;
+    std::vector<std::tuple<std::size_t, double, std::uint32_t>> order(n);
+    const auto differences = [&](std::size_t bands, auto across, auto along) {
+        for (std::uint32_t i = 0; i < n; ++i) {
+            const double t = std::max(0.0, across(positions[i])) * double(bands);
+            order[i] = {std::min(bands - 1, std::size_t(t)), along(positions[i]), i};
+        }
+        std::sort(order.begin(), order.end());
+        const auto value = [&](std::size_t k) { return samples[std::get<2>(order[k])]; };
+        for (std::size_t begin = 0; begin < n;) {
+            std::size_t end = begin + 1;
+            while (end < n && std::get<0>(order[end]) == std::get<0>(order[begin])) ++end;
+            if (end - begin == 2) {
+                const Color d = value(begin + 1) - value(begin);
+                sum += d * d / 2.0;
+                terms += 1;
+            }
+            for (std::size_t k = begin + 1; end - begin >= 3 && k + 1 < end; ++k) {
+                const Color d = value(k - 1) - 2.0 * value(k) + value(k + 1);
+                sum += d * d / 6.0;
+                terms += 1;
+            }
+            begin = end;
+        }
+    };
+    differences(
+        rows, [](const Vec2& p) { return p.y; }, [](const Vec2& p) { return p.x; });
+    differences(
+        columns, [](const Vec2& p) { return p.x; }, [](const Vec2& p) { return p.y; });
+    return sum / (terms * double(n));
+}
+
+TEST(StrataSpread, IsTheFullSortsValueBitForBit) {
+    std::mt19937_64 random(31);
+    std::uniform_real_distribution<double> uniform;
+    StrataScratch scratch;  // shared, as a thread's is from pixel to pixel of different counts
+    for (const std::size_t n : {3, 7, 64, 1000, 1024, 5, 4096, 2}) {
+        std::vector<Vec2> at(n);
+        std::vector<Color> samples(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            // Every fourth sample repeats an earlier place (ties broken by index), and some
+            // bands are left empty by crowding y into the lower half for small n.
+            at[i] = i % 4 == 3 ? at[i / 2]
+                               : Vec2{uniform(random), uniform(random) * (n < 10 ? 0.5 : 1)};
+            samples[i] = {uniform(random), uniform(random) * uniform(random), double(i % 3)};
+        }
+        const Color expected = strata_spread_by_full_sort(at, samples);
+        const Color got = strata_spread(at, samples, scratch);
+        EXPECT_EQ(got.r, expected.r) << n;
+        EXPECT_EQ(got.g, expected.g) << n;
+        EXPECT_EQ(got.b, expected.b) << n;
+        EXPECT_GT(got.r, 0) << n;
+    }
 }
 
 // The variance of a jittered 16 x 16 pixel's mean, over many patterns: what the strata spread

@@ -127,6 +127,52 @@ TEST(Sampler, RunPointsAreExactlyGet2dsInAnyOrder) {
     }
 }
 
+// Samplers remember per thread what a dimension of the pixel in hand derives from (its keys, a
+// grid's shuffles): the numbers must not depend on which were asked for before, in particular
+// not on another seed's, pixel's or branch's of the same dimension, or on another dimension
+// that shares its slot (d and d + 64, branches that differ only in high bits).
+TEST(Sampler, NumbersDoNotDependOnWhatWasAskedBefore) {
+    struct Request {
+        PixelSample s;
+        std::uint32_t dim;
+    };
+    for (const std::string& name : sampler_names()) {
+        const auto sampler = make_sampler(name);
+        for (const std::uint32_t count : {16u, 300u, 2048u}) {
+            std::vector<Request> requests;
+            for (const std::uint64_t seed : {1u, 2u}) {
+                for (const std::uint32_t pixel : {5u, 6u}) {
+                    for (const std::uint64_t path :
+                         {std::uint64_t{0}, std::uint64_t{77}, std::uint64_t{1} << 40}) {
+                        for (const std::uint32_t dim : {0u, 1u, 2u, 20u, 21u, 84u, 85u}) {
+                            for (const std::uint32_t index : {0u, 1u, 7u, count - 1}) {
+                                requests.push_back({{seed, pixel, index, count, path}, dim});
+                            }
+                        }
+                    }
+                }
+            }
+            const auto ask = [&](const Request& r) {
+                const Vec2 p = sampler->get_2d(r.s, r.dim);
+                return std::vector<double>{sampler->get_1d(r.s, r.dim), p.x, p.y};
+            };
+            std::vector<std::vector<double>> in_order;
+            for (const Request& r : requests) in_order.push_back(ask(r));
+            // Backwards, then in a stride that interleaves seeds, pixels, branches and dimensions,
+            // twice over so that every remembered value is also asked for again.
+            for (std::size_t i = requests.size(); i-- > 0;) {
+                EXPECT_EQ(ask(requests[i]), in_order[i]) << name << " " << count << " " << i;
+            }
+            for (int pass = 0; pass < 2; ++pass) {
+                for (std::size_t j = 0; j < requests.size(); ++j) {
+                    const std::size_t i = j * 37 % requests.size();
+                    EXPECT_EQ(ask(requests[i]), in_order[i]) << name << " " << count << " " << i;
+                }
+            }
+        }
+    }
+}
+
 TEST(Sampler, ValuesLieInTheHalfOpenUnitInterval) {
     for (const std::string& name : sampler_names()) {
         const auto sampler = make_sampler(name);

@@ -25,7 +25,6 @@
 #include <optional>
 #include <span>
 #include <string>
-#include <tuple>
 #include <vector>
 
 #include "drt/io/image.h"
@@ -70,11 +69,16 @@ struct ErrorSums {
 // than two samples.
 Color pixel_spread(std::span<const Color> samples);
 
-// strata_spread's sort buffer, kept from pixel to pixel by its caller (one per thread) so that a
-// pixel's spread allocates nothing once the buffer has grown to the pixel's samples.
+// strata_spread's sort buffers, kept from pixel to pixel by its caller (one per thread) so that a
+// pixel's spread allocates nothing once the buffers have grown to the pixel's samples.
 struct StrataScratch {
-    // (band, place along it, sample index) of each sample, as strata_spread sorts them.
-    std::vector<std::tuple<std::size_t, double, std::uint32_t>> order;
+    struct Entry {
+        double along;  // the sample's place along its band
+        std::uint32_t index;
+    };
+    std::vector<std::uint32_t> band;   // each sample's band
+    std::vector<std::uint32_t> start;  // where each band's samples begin in `order`
+    std::vector<Entry> order;          // the samples band by band, each band in order along it
 };
 
 // The spread of a stratified or Sobol pixel (the calibrated samplers): the variance of its mean
