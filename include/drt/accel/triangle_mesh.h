@@ -45,6 +45,11 @@ class TriangleMesh {
     // The same, emptying `obj` before the hierarchy is built, which lowers the peak memory.
     TriangleMesh(ObjMesh&& obj, const MeshTransform& transform, bool smooth, int build_threads = 0);
 
+    // Whether a mesh whose origin is `origin` keeps a triangle of non-zero area with corners
+    // a, b, c (in the transform's coordinates): they fit in single precision about the origin,
+    // and rounded to it they still span an area.
+    static bool holds(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& origin);
+
     std::size_t triangle_count() const { return triangles_.size(); }
     std::size_t dropped() const { return dropped_; }
     // Triangles of non-zero area whose corners, in single precision, lie on a line: no ray
