@@ -203,11 +203,16 @@ Vec3 TriangleMesh::lifted(std::uint32_t triangle, const Barycentrics& b) const {
 std::size_t TriangleMesh::bytes() const {
     return positions_.capacity() * sizeof(Float3) + normals_.capacity() * sizeof(Float3) +
            triangles_.capacity() * sizeof(triangles_[0]) +
-           texcoords_.capacity() * sizeof(texcoords_[0]) + tree_.memory() + sizeof(*this);
+           texcoords_.capacity() * sizeof(texcoords_[0]) + corners_.capacity() * sizeof(float) +
+           tree_.memory() + sizeof(*this);
 }
 
 void TriangleMesh::build_hierarchy(int threads) {
-    if (triangles_.empty()) return;
+    if (triangles_.empty()) {
+        vertex_count_ = positions_.size();
+        positions_ = {};
+        return;
+    }
     threads = worker_threads(threads);
     BinaryTree tree = build_binary_tree(positions_, triangles_, threads);
     tree_ = MeshTree(std::move(tree.nodes));
@@ -223,6 +228,33 @@ void TriangleMesh::build_hierarchy(int threads) {
         texcoords_ = std::move(uv_ordered);
     }
     order_vertices_by_leaves();
+    make_corner_arrays();
+}
+
+void TriangleMesh::make_corner_arrays() {
+    const std::size_t count = triangles_.size();
+    stride_ = count + 3;
+    corners_.assign(9 * stride_, 0.0f);
+    for (std::size_t i = 0; i < stride_; ++i) {
+        const auto& t = triangles_[std::min(i, count - 1)];
+        for (int v = 0; v < 3; ++v) {
+            for (int a = 0; a < 3; ++a)
+                corners_[static_cast<std::size_t>(3 * v + a) * stride_ + i] = positions_[t[v]][a];
+        }
+    }
+    vertex_count_ = positions_.size();
+    positions_ = {};
+}
+
+std::vector<Float3> TriangleMesh::positions() const {
+    std::vector<Float3> positions(vertex_count_, Float3{});
+    for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
+        for (int v = 0; v < 3; ++v) {
+            positions[triangles_[t][v]] = {coordinate(t, v, 0), coordinate(t, v, 1),
+                                           coordinate(t, v, 2)};
+        }
+    }
+    return positions;
 }
 
 void TriangleMesh::order_vertices_by_leaves() {
