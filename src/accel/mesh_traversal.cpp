@@ -156,7 +156,13 @@ TriangleMesh::Answer<kAnyHit> TriangleMesh::traverse(const Ray& ray, Interval ra
     alignas(16) double inv[4];
     _mm_store_pd(inv, _mm_div_pd(_mm_set1_pd(1), _mm_setr_pd(ray.dir.x, ray.dir.y)));
     inv[2] = 1 / ray.dir.z;
-    const WideRay wide(ray, range, inv);
+    // A mesh of one leaf (up to eight triangles) has a root whose one box is the mesh's, which
+    // the scene's BVH has mostly tested already: its triangles are tested at once, without the
+    // wide ray. The box test only saves triangle tests, so no answer changes.
+    const MeshTree::Node& root = tree_.node(0);
+    const bool one_leaf = root.children == 1 && root.count[0] > 0;
+    std::optional<WideRay> wide;
+    if (!one_leaf) wide.emplace(ray, range, inv);
     const ShearedRay::Axes axes = ShearedRay::axes_of(ray.dir);
     const FloatShearedRay filter(ray.origin, axes, ray.dir[axes.kx] * inv[axes.kz],
                                  ray.dir[axes.ky] * inv[axes.kz], inv[axes.kz]);
@@ -167,18 +173,15 @@ TriangleMesh::Answer<kAnyHit> TriangleMesh::traverse(const Ray& ray, Interval ra
     // (never used by the renderer) leaves the near end to the double test.
     const float filter_near =
         range.min >= 0 ? to_float_down(range.min) : -std::numeric_limits<float>::infinity();
-    // Corners of triangles first .. first + lanes - 1 in the filter's axis order; lanes past
-    // the leaf's end repeat its last triangle and are masked off.
-    const auto gather = [&](std::uint32_t first, std::uint32_t lanes) {
-        std::array<const std::array<std::uint32_t, 3>*, 4> t{};
-        for (std::uint32_t k = 0; k < 4; ++k) t[k] = &triangles_[first + std::min(k, lanes - 1)];
+    // The corners of triangles first .. first + 3 in the filter's axis order (lanes past the
+    // leaf's end hold other triangles, and are masked off).
+    const auto load = [&](std::uint32_t first) {
         TriangleBatch batch;
         for (int v = 0; v < 3; ++v) {
-            const Float3 &p0 = positions_[(*t[0])[v]], &p1 = positions_[(*t[1])[v]],
-                         &p2 = positions_[(*t[2])[v]], &p3 = positions_[(*t[3])[v]];
             for (int a = 0; a < 3; ++a) {
-                const int k = order_of_axes[a];
-                batch.corners[v][a] = _mm_setr_ps(p0[k], p1[k], p2[k], p3[k]);
+                batch.corners[v][a] = _mm_loadu_ps(
+                    &corners_[static_cast<std::size_t>(3 * v + order_of_axes[a]) * stride_ +
+                              first]);
             }
         }
         return batch;
@@ -209,8 +212,8 @@ TriangleMesh::Answer<kAnyHit> TriangleMesh::traverse(const Ray& ray, Interval ra
     };
     std::array<Pending, kStackSize> stack;
     int top = 0;
-    Pending current{0, 0, near};
-    const bool flat = wide.flat != 0;
+    Pending current = one_leaf ? Pending{root.child[0], root.count[0], near} : Pending{0, 0, near};
+    const bool flat = wide && wide->flat != 0;
     while (true) {
         if (current.count > 0) {
             // Four triangles at a time through the float filter; those it cannot rule out, in
@@ -224,13 +227,13 @@ TriangleMesh::Answer<kAnyHit> TriangleMesh::traverse(const Ray& ray, Interval ra
                     // A triangle the filter proves the double test would hit answers the
                     // query without that test, which every blocked ray would otherwise run.
                     if (use_filter) {
-                        const auto verdict = filter.classify(gather(first, lanes), filter_near, far,
+                        const auto verdict = filter.classify(load(first), filter_near, far,
                                                              certain_low, certain_high);
                         if (!kAlpha && (verdict.certain & maybe)) return true;
                         maybe &= verdict.maybe;
                     }
                 } else if (use_filter) {
-                    maybe &= filter.maybe_hits(gather(first, lanes), filter_near, far);
+                    maybe &= filter.maybe_hits(load(first), filter_near, far);
                 }
                 for (; maybe != 0; maybe &= maybe - 1) {
                     const std::uint32_t i = first + std::countr_zero(static_cast<unsigned>(maybe));
@@ -253,8 +256,8 @@ TriangleMesh::Answer<kAnyHit> TriangleMesh::traverse(const Ray& ray, Interval ra
         } else {
             const MeshTree::Node& node = tree_.node(current.child);
             alignas(32) float entry[MeshTree::kWidth];
-            const int mask = (flat ? wide.hits<true>(node.box, near, far, entry)
-                                   : wide.hits<false>(node.box, near, far, entry)) &
+            const int mask = (flat ? wide->hits<true>(node.box, near, far, entry)
+                                   : wide->hits<false>(node.box, near, far, entry)) &
                              ((1 << node.children) - 1);
             if (mask != 0 && kAnyHit) {
                 // Any hit will do, and whichever is found first gives the same answer: the

@@ -22,7 +22,28 @@ double corner_angle(const Vec3& a, const Vec3& b, const Vec3& c) {
     return std::atan2(length(cross(u, v)), dot(u, v));
 }
 
+// A placed vertex in a mesh's own coordinates; not finite if it does not fit in a float.
+Float3 to_local(const Vec3& placed, const Vec3& origin) {
+    const Vec3 v = placed - origin;
+    return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
+}
+
+bool finite(const Float3& f) {
+    return std::isfinite(f[0]) && std::isfinite(f[1]) && std::isfinite(f[2]);
+}
+
+// Whether corners rounded to single precision lie on a line.
+bool flattened(const Float3& a, const Float3& b, const Float3& c) {
+    const Vec3 p = to_vec3(a);
+    return cross(to_vec3(b) - p, to_vec3(c) - p) == Vec3{};
+}
+
 }  // namespace
+
+bool TriangleMesh::holds(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& origin) {
+    const Float3 fa = to_local(a, origin), fb = to_local(b, origin), fc = to_local(c, origin);
+    return finite(fa) && finite(fb) && finite(fc) && !flattened(fa, fb, fc);
+}
 
 TriangleMesh::TriangleMesh(const ObjMesh& obj, const MeshTransform& transform, bool smooth,
                            int build_threads) {
@@ -70,9 +91,8 @@ void TriangleMesh::take(const ObjMesh& obj, const MeshTransform& transform, bool
     }
 
     const auto local = [&](std::uint32_t p) {
-        const Vec3 v = placed[p] - origin_;
-        const Float3 f{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
-        if (!std::isfinite(f[0]) || !std::isfinite(f[1]) || !std::isfinite(f[2])) {
+        const Float3 f = to_local(placed[p], origin_);
+        if (!finite(f)) {
             throw std::domain_error("vertex " + std::to_string(p + 1) +
                                     " is beyond single precision (±3.4e38) once transformed");
         }
@@ -90,9 +110,7 @@ void TriangleMesh::take(const ObjMesh& obj, const MeshTransform& transform, bool
             ++dropped_;
             continue;
         }
-        const Vec3 a = to_vec3(local_positions[p[0]]), b = to_vec3(local_positions[p[1]]),
-                   d = to_vec3(local_positions[p[2]]);
-        if (cross(b - a, d - a) == Vec3{}) {
+        if (flattened(local_positions[p[0]], local_positions[p[1]], local_positions[p[2]])) {
             ++collapsed_;
             continue;
         }
@@ -185,11 +203,16 @@ Vec3 TriangleMesh::lifted(std::uint32_t triangle, const Barycentrics& b) const {
 std::size_t TriangleMesh::bytes() const {
     return positions_.capacity() * sizeof(Float3) + normals_.capacity() * sizeof(Float3) +
            triangles_.capacity() * sizeof(triangles_[0]) +
-           texcoords_.capacity() * sizeof(texcoords_[0]) + tree_.memory() + sizeof(*this);
+           texcoords_.capacity() * sizeof(texcoords_[0]) + corners_.capacity() * sizeof(float) +
+           tree_.memory() + sizeof(*this);
 }
 
 void TriangleMesh::build_hierarchy(int threads) {
-    if (triangles_.empty()) return;
+    if (triangles_.empty()) {
+        vertex_count_ = positions_.size();
+        positions_ = {};
+        return;
+    }
     threads = worker_threads(threads);
     BinaryTree tree = build_binary_tree(positions_, triangles_, threads);
     tree_ = MeshTree(std::move(tree.nodes));
@@ -205,6 +228,33 @@ void TriangleMesh::build_hierarchy(int threads) {
         texcoords_ = std::move(uv_ordered);
     }
     order_vertices_by_leaves();
+    make_corner_arrays();
+}
+
+void TriangleMesh::make_corner_arrays() {
+    const std::size_t count = triangles_.size();
+    stride_ = count + 3;
+    corners_.assign(9 * stride_, 0.0f);
+    for (std::size_t i = 0; i < stride_; ++i) {
+        const auto& t = triangles_[std::min(i, count - 1)];
+        for (int v = 0; v < 3; ++v) {
+            for (int a = 0; a < 3; ++a)
+                corners_[static_cast<std::size_t>(3 * v + a) * stride_ + i] = positions_[t[v]][a];
+        }
+    }
+    vertex_count_ = positions_.size();
+    positions_ = {};
+}
+
+std::vector<Float3> TriangleMesh::positions() const {
+    std::vector<Float3> positions(vertex_count_, Float3{});
+    for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
+        for (int v = 0; v < 3; ++v) {
+            positions[triangles_[t][v]] = {coordinate(t, v, 0), coordinate(t, v, 1),
+                                           coordinate(t, v, 2)};
+        }
+    }
+    return positions;
 }
 
 void TriangleMesh::order_vertices_by_leaves() {

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "drt/accel/mesh.h"
+#include "drt/geometry/collinear.h"
 #include "drt/geometry/mesh_transform.h"
 #include "drt/geometry/plane.h"
 #include "drt/geometry/sphere.h"
@@ -303,6 +304,32 @@ struct SurfaceSpec {
 
     bool image_texture() const { return textured && texture == kImageTexture; }
 
+    // Whether objects of this surface and of `other` look alike in every attribute (images
+    // compared by identity: the texture cache gives one file one image), so that they can share
+    // one object.
+    bool same_as(const SurfaceSpec& other) const {
+        const auto same_bump = [](const std::optional<BumpMap>& a,
+                                  const std::optional<BumpMap>& b) {
+            return a.has_value() == b.has_value() &&
+                   (!a || (a->scale == b->scale && a->strength == b->strength));
+        };
+        const auto same_corners = [](const std::optional<std::array<Vec2, 3>>& a,
+                                     const std::optional<std::array<Vec2, 3>>& b) {
+            if (a.has_value() != b.has_value()) return false;
+            for (std::size_t k = 0; a && k < 3; ++k) {
+                if ((*a)[k].x != (*b)[k].x || (*a)[k].y != (*b)[k].y) return false;
+            }
+            return true;
+        };
+        return textured == other.textured && texture == other.texture &&
+               texture_scale == other.texture_scale && k2.r == other.k2.r && k2.g == other.k2.g &&
+               k2.b == other.k2.b && same_bump(bump, other.bump) &&
+               texture_file == other.texture_file && bump_file == other.bump_file &&
+               image == other.image && height == other.height &&
+               bump_strength == other.bump_strength && filter == other.filter &&
+               same_corners(corner_uv, other.corner_uv);
+    }
+
     SurfaceDetail build(const Material& material) const {
         SurfaceDetail detail;
         if (image) {
@@ -384,6 +411,7 @@ class SceneReader {
         const XMLElement& root = root_element(doc);
         scene_.path = context_.file();
         read_scene(root);
+        build_triangle_groups();
         resolve_objects();
         add_emitting_lights();
         for (auto& m : obj_materials_) scene_.materials.push_back(std::move(m));
@@ -829,13 +857,21 @@ class SceneReader {
 
     // Triangles and meshes (docs/scene-format.md, "Meshes").
 
+    // The <Triangle>s of one material and one surface become one mesh (a scene of many pays a
+    // mesh's per-ray set-up once instead of once per triangle), built when every one is read
+    // (build_triangle_groups), in the place of the group's first among the scene's objects.
+    struct TriangleGroup {
+        std::string material;
+        SurfaceSpec surface;
+        std::vector<std::array<Vec3, 3>> corners;
+        std::vector<const XMLElement*> elements;  // per triangle, for messages
+        std::shared_ptr<const TriangleMesh> mesh;
+    };
+
     void read_triangle(const XMLElement& e) {
         Attributes in(e, context_);
-        ObjMesh obj;
-        obj.positions = {in.vec3("Ax", "Ay", "Az"), in.vec3("Bx", "By", "Bz"),
-                         in.vec3("Cx", "Cy", "Cz")};
-        obj.position_indices = {0, 1, 2};
-        obj.normal_indices.assign(3, ObjMesh::kNoNormal);
+        const std::array<Vec3, 3> corners{in.vec3("Ax", "Ay", "Az"), in.vec3("Bx", "By", "Bz"),
+                                          in.vec3("Cx", "Cy", "Cz")};
         std::string material = in.text("Material");
         SurfaceSpec surface = read_surface(in);
         surface.corner_uv = {Vec2{in.number("Au", 0), in.number("Av", 0)},
@@ -844,16 +880,72 @@ class SceneReader {
         load_images(in, surface);
         in.warn_unknown();
         warn_children(e);
-        auto mesh = build_mesh(in, std::move(obj), {}, false);
-        if (mesh->dropped() > 0) context_.warn(e, "<Triangle> of zero area dropped");
-        if (mesh->collapsed() > 0) {
-            context_.warn(e, "<Triangle> too thin for single precision dropped");
+        // Said here, in the file's order; the mesh leaves the triangle out (TriangleMesh).
+        if (collinear(corners[0], corners[1], corners[2]))
+            context_.warn(e, "<Triangle> of zero area dropped");
+        const auto group = std::ranges::find_if(triangle_groups_, [&](const auto& g) {
+            return g->material == material && g->surface.same_as(surface);
+        });
+        if (group != triangle_groups_.end()) {
+            (*group)->corners.push_back(corners);
+            (*group)->elements.push_back(&e);
+            return;
         }
+        auto made = std::make_shared<TriangleGroup>(
+            TriangleGroup{material, surface, {corners}, {&e}, nullptr});
+        triangle_groups_.push_back(made);
         pending_.push_back({&e, std::move(material), std::move(surface),
-                            [mesh = std::move(mesh)](const Material& m, SurfaceDetail d) {
-                                return std::make_unique<Mesh>(mesh, std::vector<Vec3>{Vec3{}}, m,
-                                                              std::move(d));
+                            [group = std::move(made)](const Material& m, SurfaceDetail d) {
+                                return std::make_unique<Mesh>(
+                                    group->mesh, std::vector<Vec3>{Vec3{}}, m, std::move(d));
                             }});
+    }
+
+    // The meshes of the <Triangle> groups. A triangle that single precision cannot hold about its
+    // group's origin (a small one far from the others) is an object of its own, as it was before
+    // triangles were grouped: it is dropped with a warning only if it cannot be held even so.
+    void build_triangle_groups() {
+        const auto mesh_of = [this](const XMLElement& e, std::span<const std::array<Vec3, 3>> t,
+                                    const MeshTransform& transform) {
+            ObjMesh obj;
+            for (const auto& corners : t) {
+                const auto first = static_cast<std::uint32_t>(obj.positions.size());
+                obj.positions.insert(obj.positions.end(), corners.begin(), corners.end());
+                obj.position_indices.insert(obj.position_indices.end(),
+                                            {first, first + 1, first + 2});
+            }
+            obj.normal_indices.assign(obj.position_indices.size(), ObjMesh::kNoNormal);
+            Attributes in(e, context_);
+            return build_mesh(in, std::move(obj), transform, false);
+        };
+        for (const auto& group : triangle_groups_) {
+            Bounds box;
+            for (const auto& corners : group->corners) {
+                for (const Vec3& p : corners) box.grow(p);
+            }
+            MeshTransform transform;
+            transform.origin = box.centre();
+            std::vector<std::array<Vec3, 3>> kept;
+            for (std::size_t i = 0; i < group->corners.size(); ++i) {
+                const auto& [a, b, c] = group->corners[i];
+                const XMLElement& e = *group->elements[i];
+                if (collinear(a, b, c) || TriangleMesh::holds(a, b, c, *transform.origin)) {
+                    kept.push_back(group->corners[i]);
+                    continue;
+                }
+                auto mesh = mesh_of(e, std::span(&group->corners[i], 1), MeshTransform{});
+                if (mesh->collapsed() > 0) {
+                    context_.warn(e, "<Triangle> too thin for single precision dropped");
+                    continue;
+                }
+                pending_.push_back({&e, group->material, group->surface,
+                                    [mesh = std::move(mesh)](const Material& m, SurfaceDetail d) {
+                                        return std::make_unique<Mesh>(
+                                            mesh, std::vector<Vec3>{Vec3{}}, m, std::move(d));
+                                    }});
+            }
+            group->mesh = mesh_of(*group->elements.front(), kept, transform);
+        }
     }
 
     void read_mesh(const XMLElement& e) {
@@ -1144,6 +1236,7 @@ class SceneReader {
     std::map<std::string, int, std::less<>> setting_lines_;
     std::map<std::string, int, std::less<>> material_lines_;
     std::vector<PendingObject> pending_;
+    std::vector<std::shared_ptr<TriangleGroup>> triangle_groups_;
     struct EmittingLight {
         Vec3 centre;
         double radius;

@@ -158,6 +158,56 @@ TEST(TriangleMesh, NearestHitIsThatOfTestingEveryTriangle) {
     }
 }
 
+// A mesh of one leaf is tested without its root's box (mesh_traversal.cpp), through the corner
+// arrays' lanes past its end: 1 to 8 crossing triangles, each kept where the file put it, and
+// hit as testing each of them finds, from in front, from behind and by rays that miss.
+TEST(TriangleMesh, MeshesOfOneLeafFindTheHitOfTestingEveryTriangle) {
+    for (std::uint32_t n = 1; n <= 8; ++n) {
+        testing::TestMesh soup;
+        for (std::uint64_t i = 0; i < n; ++i) {
+            const auto first = static_cast<std::uint32_t>(soup.vertices.size());
+            for (std::uint64_t k = 0; k < 3; ++k)
+                soup.vertices.push_back(testing::unit_vector(21, 3 * (8 * n + i) + k) +
+                                        Vec3{5, 0, 0});
+            soup.triangles.push_back({first, first + 1, first + 2});
+        }
+        const TriangleMesh mesh(testing::obj_of(soup), {}, false);
+        ASSERT_EQ(mesh.triangle_count(), n);
+        // Every file triangle is one of the mesh's, corner for corner.
+        for (const auto& t : soup.triangles) {
+            bool kept = false;
+            for (std::uint32_t m = 0; m < n; ++m) {
+                const auto c = mesh.corners(m);
+                bool same = true;
+                for (int v = 0; v < 3; ++v)
+                    same = same && near(c[v] + mesh.origin(), soup.vertices[t[v]], 1e-6);
+                kept = kept || same;
+            }
+            EXPECT_TRUE(kept) << n << " triangles";
+        }
+        int hits = 0;
+        for (std::uint64_t r = 0; r < 500; ++r) {
+            const Vec3 origin = testing::unit_vector(22, r) * (r % 2 ? 0.3 : 2.5);
+            const Ray ray{origin, testing::unit_vector(23, r)};
+            std::optional<MeshHit> expected;
+            for (std::uint32_t t = 0; t < n; ++t) {
+                const auto [a, b, c] = mesh.corners(t);
+                const auto hit = intersect_triangle(ray, a, b, c, {0, kInfinity});
+                if (hit && (!expected || hit->t < expected->t))
+                    expected = MeshHit{hit->t, t, hit->b};
+            }
+            const auto found = mesh.intersect(ray, {0, kInfinity});
+            ASSERT_EQ(found.has_value(), expected.has_value()) << n << " triangles, ray " << r;
+            EXPECT_EQ(mesh.occluded(ray, {0, kInfinity}), expected.has_value());
+            if (!found) continue;
+            ++hits;
+            EXPECT_EQ(found->t, expected->t) << n << " triangles, ray " << r;
+            EXPECT_EQ(found->triangle, expected->triangle) << n << " triangles, ray " << r;
+        }
+        EXPECT_GT(hits, 10) << n << " triangles";
+    }
+}
+
 // Rays through the mesh's own corners and through points on its shared edges (not
 // representable in float, so that the float filter in front of the double test sees rounded
 // origins), from outside and from inside: the hierarchy with its float filter finds exactly the
@@ -249,11 +299,13 @@ TEST(TriangleMesh, BuildsTheSameHierarchyOnOneThreadAsOnSeveral) {
     }
 }
 
-TEST(TriangleMesh, TakesUnderEightyBytesPerTriangleWithItsHierarchy) {
+// Issue 12's budget was 80 bytes; the leaf test's corner arrays (36 bytes a triangle, in place
+// of the shared positions' 6) bought the float filter its loads for about 30 more (issue 31).
+TEST(TriangleMesh, TakesUnderAHundredBytesPerTriangleWithItsHierarchy) {
     const TriangleMesh smooth(testing::obj_of(testing::icosphere(5)), {}, true);
     ASSERT_EQ(smooth.triangle_count(), 20480u);
     const double per_triangle = static_cast<double>(smooth.bytes()) / smooth.triangle_count();
-    EXPECT_LT(per_triangle, 80);
+    EXPECT_LT(per_triangle, 100);
     RecordProperty("bytes_per_triangle", std::to_string(per_triangle));
 }
 

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <charconv>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -987,6 +989,81 @@ TEST(SceneLoader, ATriangleOfZeroAreaIsDroppedWithAWarning) {
     EXPECT_EQ(mesh(loaded.scene, 0).mesh().triangle_count(), 0u);
     EXPECT_EQ(loaded.warnings,
               std::vector<std::string>{"t.xml:3: warning: <Triangle> of zero area dropped"});
+}
+
+// A <Triangle> with the given corners (x y z, three times) and attributes.
+std::string triangle(const std::array<double, 9>& c, std::string_view attributes) {
+    static constexpr std::string_view kNames[] = {"Ax", "Ay", "Az", "Bx", "By",
+                                                  "Bz", "Cx", "Cy", "Cz"};
+    std::string xml = "<Triangle";
+    for (std::size_t k = 0; k < 9; ++k) {
+        char number[32];
+        const auto end = std::to_chars(number, number + sizeof number, c[k]).ptr;
+        xml += " " + std::string(kNames[k]) + "=\"" + std::string(number, end) + "\"";
+    }
+    return xml + " " + std::string(attributes) + "/>\n";
+}
+
+// A mesh's per-ray set-up is paid once for all the <Triangle>s of one material and surface.
+TEST(SceneLoader, TrianglesOfOneMaterialAndSurfaceAreOneObject) {
+    const std::string body =
+        "<Materials><Gray/><Red/></Materials>\n" +
+        triangle({0, 0, 0, 1, 0, 0, 0, 1, 0}, "Material=\"Gray\"") +
+        triangle({0, 0, 1, 1, 0, 1, 0, 1, 1}, "Material=\"Red\"") +
+        triangle({0, 0, 2, 1, 0, 2, 0, 1, 2}, "Material=\"Gray\"") +
+        triangle({0, 0, 3, 1, 0, 3, 0, 1, 3}, "Material=\"Gray\" EnableTexture=\"1\"") +
+        triangle({0, 0, 4, 1, 0, 4, 0, 1, 4}, "Material=\"Red\"") +
+        triangle({5, 0, 5, 7, 0, 5, 5, 3, 5}, "Material=\"Gray\"") +
+        triangle({0, 0, 6, 1, 0, 6, 0, 1, 6}, "Material=\"Gray\" Au=\"0.5\"");
+    const LoadedScene loaded = load(in_scene(body));
+    EXPECT_TRUE(loaded.warnings.empty());
+    // In the order of each group's first triangle.
+    ASSERT_EQ(loaded.scene.objects.size(), 4u);
+    EXPECT_EQ(mesh(loaded.scene, 0).mesh().triangle_count(), 3u);
+    EXPECT_EQ(loaded.scene.objects[0]->material().name, "Gray");
+    EXPECT_EQ(mesh(loaded.scene, 1).mesh().triangle_count(), 2u);
+    EXPECT_EQ(loaded.scene.objects[1]->material().name, "Red");
+    EXPECT_EQ(mesh(loaded.scene, 2).mesh().triangle_count(), 1u);
+    EXPECT_TRUE(mesh(loaded.scene, 2).detail().texture);
+    EXPECT_EQ(mesh(loaded.scene, 3).mesh().triangle_count(), 1u);
+    // Every triangle keeps its corners, whichever the leaf order puts first.
+    const Mesh& gray = mesh(loaded.scene, 0);
+    const Vec3 o = gray.path().at(0);
+    bool found = false;
+    for (std::uint32_t t = 0; t < 3; ++t) {
+        const auto [a, b, c] = gray.mesh().corners(t);
+        if (a + o == Vec3{5, 0, 5}) {
+            found = true;
+            expect_vec(b + o, 7, 0, 5);
+            expect_vec(c + o, 5, 3, 5);
+        }
+    }
+    EXPECT_TRUE(found);
+}
+
+// Warnings stay with their <Triangle>; one that the group's single precision would flatten
+// (small and far from the others) is an object of its own instead of lost.
+TEST(SceneLoader, GroupedTrianglesKeepTheirWarningsAndTheirDetail) {
+    const std::string body =
+        std::string(kGray) + "\n" + triangle({0, 0, 0, 1, 0, 0, 0, 1, 0}, "Material=\"Gray\"") +
+        triangle({0, 0, 0, 1, 1, 1, 2, 2, 2}, "Material=\"Gray\"") +
+        triangle({1e7, 0, 0, 1e7 + 0.01, 0, 0, 1e7, 0.01, 0}, "Material=\"Gray\"") +
+        triangle({0, 0, 0, 1, 1, 0, 3, 3.0000000001, 0}, "Material=\"Gray\"");
+    const LoadedScene loaded = load(in_scene(body));
+    EXPECT_EQ(loaded.warnings,
+              (std::vector<std::string>{
+                  "t.xml:4: warning: <Triangle> of zero area dropped",
+                  "t.xml:6: warning: <Triangle> too thin for single precision dropped"}));
+    ASSERT_EQ(loaded.scene.objects.size(), 2u);
+    EXPECT_EQ(mesh(loaded.scene, 0).mesh().triangle_count(), 1u);
+    EXPECT_EQ(mesh(loaded.scene, 0).mesh().dropped(), 1u);
+    const Mesh& far = mesh(loaded.scene, 1);
+    ASSERT_EQ(far.mesh().triangle_count(), 1u);
+    const Vec3 o = far.path().at(0);
+    const auto [a, b, c] = far.mesh().corners(0);
+    EXPECT_NEAR((b - a).x, 0.01, 1e-9);
+    EXPECT_NEAR((c - a).y, 0.01, 1e-9);
+    EXPECT_NEAR((a + o).x, 1e7, 1e-6);
 }
 
 constexpr std::string_view kTetrahedron =
