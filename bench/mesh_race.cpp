@@ -188,7 +188,7 @@ class EmbreeScene {
         auto* vertices = static_cast<float*>(
             rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                     3 * sizeof(float), positions.size()));
-        std::memcpy(vertices, positions.data(), positions.size() * sizeof(positions[0]));
+        std::memcpy(vertices, positions.data(), positions.size_bytes());
         const auto triangles = mesh.triangles();
         auto* indices = static_cast<std::uint32_t*>(
             rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,

@@ -173,15 +173,29 @@ TriangleMesh::Answer<kAnyHit> TriangleMesh::traverse(const Ray& ray, Interval ra
     // (never used by the renderer) leaves the near end to the double test.
     const float filter_near =
         range.min >= 0 ? to_float_down(range.min) : -std::numeric_limits<float>::infinity();
-    // The corners of triangles first .. first + 3 in the filter's axis order (lanes past the
-    // leaf's end hold other triangles, and are masked off).
-    const auto load = [&](std::uint32_t first) {
+    // The corners of triangles first .. first + lanes - 1 in the filter's axis order; lanes past
+    // the leaf's end hold other triangles and are masked off. From a small mesh's corner arrays,
+    // else gathered through the index buffer (lanes past the end repeat the leaf's last).
+    const auto load = [&](std::uint32_t first, std::uint32_t lanes) {
         TriangleBatch batch;
+        if (!corners_.empty()) {
+            for (int v = 0; v < 3; ++v) {
+                for (int a = 0; a < 3; ++a) {
+                    batch.corners[v][a] = _mm_loadu_ps(
+                        &corners_[static_cast<std::size_t>(3 * v + order_of_axes[a]) * stride_ +
+                                  first]);
+                }
+            }
+            return batch;
+        }
+        std::array<const std::array<std::uint32_t, 3>*, 4> t{};
+        for (std::uint32_t k = 0; k < 4; ++k) t[k] = &triangles_[first + std::min(k, lanes - 1)];
         for (int v = 0; v < 3; ++v) {
+            const Float3 &p0 = positions_[(*t[0])[v]], &p1 = positions_[(*t[1])[v]],
+                         &p2 = positions_[(*t[2])[v]], &p3 = positions_[(*t[3])[v]];
             for (int a = 0; a < 3; ++a) {
-                batch.corners[v][a] = _mm_loadu_ps(
-                    &corners_[static_cast<std::size_t>(3 * v + order_of_axes[a]) * stride_ +
-                              first]);
+                const int k = order_of_axes[a];
+                batch.corners[v][a] = _mm_setr_ps(p0[k], p1[k], p2[k], p3[k]);
             }
         }
         return batch;
@@ -227,13 +241,13 @@ TriangleMesh::Answer<kAnyHit> TriangleMesh::traverse(const Ray& ray, Interval ra
                     // A triangle the filter proves the double test would hit answers the
                     // query without that test, which every blocked ray would otherwise run.
                     if (use_filter) {
-                        const auto verdict = filter.classify(load(first), filter_near, far,
+                        const auto verdict = filter.classify(load(first, lanes), filter_near, far,
                                                              certain_low, certain_high);
                         if (!kAlpha && (verdict.certain & maybe)) return true;
                         maybe &= verdict.maybe;
                     }
                 } else if (use_filter) {
-                    maybe &= filter.maybe_hits(load(first), filter_near, far);
+                    maybe &= filter.maybe_hits(load(first, lanes), filter_near, far);
                 }
                 for (; maybe != 0; maybe &= maybe - 1) {
                     const std::uint32_t i = first + std::countr_zero(static_cast<unsigned>(maybe));

@@ -208,11 +208,7 @@ std::size_t TriangleMesh::bytes() const {
 }
 
 void TriangleMesh::build_hierarchy(int threads) {
-    if (triangles_.empty()) {
-        vertex_count_ = positions_.size();
-        positions_ = {};
-        return;
-    }
+    if (triangles_.empty()) return;
     threads = worker_threads(threads);
     BinaryTree tree = build_binary_tree(positions_, triangles_, threads);
     tree_ = MeshTree(std::move(tree.nodes));
@@ -233,6 +229,7 @@ void TriangleMesh::build_hierarchy(int threads) {
 
 void TriangleMesh::make_corner_arrays() {
     const std::size_t count = triangles_.size();
+    if (count > kCornerArrayLimit) return;
     stride_ = count + 3;
     corners_.assign(9 * stride_, 0.0f);
     for (std::size_t i = 0; i < stride_; ++i) {
@@ -242,19 +239,6 @@ void TriangleMesh::make_corner_arrays() {
                 corners_[static_cast<std::size_t>(3 * v + a) * stride_ + i] = positions_[t[v]][a];
         }
     }
-    vertex_count_ = positions_.size();
-    positions_ = {};
-}
-
-std::vector<Float3> TriangleMesh::positions() const {
-    std::vector<Float3> positions(vertex_count_, Float3{});
-    for (std::uint32_t t = 0; t < triangles_.size(); ++t) {
-        for (int v = 0; v < 3; ++v) {
-            positions[triangles_[t][v]] = {coordinate(t, v, 0), coordinate(t, v, 1),
-                                           coordinate(t, v, 2)};
-        }
-    }
-    return positions;
 }
 
 void TriangleMesh::order_vertices_by_leaves() {

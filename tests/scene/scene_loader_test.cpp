@@ -999,7 +999,7 @@ std::string triangle(const std::array<double, 9>& c, std::string_view attributes
     for (std::size_t k = 0; k < 9; ++k) {
         char number[32];
         const auto end = std::to_chars(number, number + sizeof number, c[k]).ptr;
-        xml += " " + std::string(kNames[k]) + "=\"" + std::string(number, end) + "\"";
+        xml.append(" ").append(kNames[k]).append("=\"").append(number, end).append("\"");
     }
     return xml + " " + std::string(attributes) + "/>\n";
 }

@@ -77,7 +77,8 @@ class TriangleMesh {
     std::uint64_t triangle_tests(const Ray& ray, Interval range, bool any_hit) const;
 
     std::array<Vec3, 3> corners(std::uint32_t triangle) const {
-        return {corner(triangle, 0), corner(triangle, 1), corner(triangle, 2)};
+        const auto& t = triangles_[triangle];
+        return {position(t[0]), position(t[1]), position(t[2])};
     }
     // Unit (p1 - p0) × (p2 - p0): outward for a closed mesh wound counter-clockwise.
     Vec3 geometric_normal(std::uint32_t triangle) const;
@@ -102,9 +103,7 @@ class TriangleMesh {
     // The geometry as stored, for handing the same triangles to another kernel (bench/): the
     // positions relative to origin(), and each triangle's vertices, in the order whose index
     // MeshHit::triangle gives.
-    // (The positions are made again from the triangles' corners: a vertex that only dropped
-    // triangles used is at 0.)
-    std::vector<Float3> positions() const;
+    std::span<const Float3> positions() const { return positions_; }
     std::span<const std::array<std::uint32_t, 3>> triangles() const { return triangles_; }
     // The hierarchy's nodes as bytes, for telling whether two builds made the same tree.
     std::span<const std::byte> hierarchy() const { return tree_.bytes(); }
@@ -112,19 +111,14 @@ class TriangleMesh {
   private:
     // The vertices, triangles and normals of the mesh from the file's.
     void take(const ObjMesh& obj, const MeshTransform& transform, bool smooth);
+    Vec3 position(std::uint32_t vertex) const { return to_vec3(positions_[vertex]); }
     // `threads` 0: one per core.
     void build_hierarchy(int threads);
     // Numbers the vertices in the order the leaves first use them, so that a leaf's corners
     // are near each other in memory.
     void order_vertices_by_leaves();
-    // corners_ from the positions, which it replaces.
+    // corners_, for a mesh of at most kCornerArrayLimit triangles.
     void make_corner_arrays();
-    float coordinate(std::uint32_t triangle, int corner, int axis) const {
-        return corners_[static_cast<std::size_t>(3 * corner + axis) * stride_ + triangle];
-    }
-    Vec3 corner(std::uint32_t triangle, int v) const {
-        return {coordinate(triangle, v, 0), coordinate(triangle, v, 1), coordinate(triangle, v, 2)};
-    }
     // What a query answers: whether any triangle is hit, or the nearest hit.
     template <bool kAnyHit>
     using Answer = std::conditional_t<kAnyHit, bool, std::optional<MeshHit>>;
@@ -134,18 +128,21 @@ class TriangleMesh {
     Answer<kAnyHit> traverse(const Ray& ray, Interval range, std::uint64_t* tests = nullptr) const;
 
     Vec3 origin_;
-    std::vector<Float3> positions_;  // relative to origin_; while building only
+    std::vector<Float3> positions_;  // relative to origin_
     std::vector<Float3> normals_;    // per vertex, unit; empty for a flat mesh
     std::vector<std::array<std::uint32_t, 3>> triangles_;  // in leaf order
     // Per triangle, its corners' (u, v) in single precision; empty when the file has no `vt`.
     std::vector<std::array<float, 6>> texcoords_;
-    // Every triangle's float corners, one array a coordinate ([corner][axis], `stride_` floats
-    // apart) in the leaf order, so that the float filter loads a lane of four neighbouring
-    // triangles with one load, from whichever array the ray's axis order asks for. Each array
-    // ends with three copies of the last triangle, for lanes past the end.
+    // A small mesh's float corners once more, one array a coordinate ([corner][axis], `stride_`
+    // floats apart) in the leaf order, so that the float filter loads a lane of four neighbouring
+    // triangles with one load from whichever array the ray's axis order asks for, instead of
+    // gathering them through the index buffer. Each array ends with three copies of the last
+    // triangle, for lanes past the end. Empty for a larger mesh: 36 more bytes a triangle would
+    // break the budget of 80 with the hierarchy, and a large mesh's time goes to memory, not to
+    // the gather's instructions.
+    static constexpr std::size_t kCornerArrayLimit = 4096;
     std::vector<float> corners_;
     std::size_t stride_ = 0;
-    std::size_t vertex_count_ = 0;
     MeshTree tree_;
     std::shared_ptr<const MipMap> alpha_;  // null: no cut-outs
     std::size_t dropped_ = 0;
