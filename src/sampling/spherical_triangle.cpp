@@ -24,7 +24,7 @@ Vec3 sample_spherical_triangle(const SphericalTriangle& t, Vec2 u) {
     // from (a×b)×(a×c) = (a·(b×c))·a, so no inverse cosine is needed, nor α itself: only the
     // sine and cosine of (sub-area − α).
     const Vec3 ab = cross(a, b), ac = cross(a, t.c);
-    const double lengths = length(ab) * length(ac);
+    const double lengths = std::sqrt(dot(ab, ab) * dot(ac, ac));
     const double cos_alpha = std::clamp(dot(ab, ac) / lengths, -1.0, 1.0);
     const double sin_alpha = t.triple / lengths;
     const double sub_area = u.x * t.area;
@@ -48,9 +48,8 @@ Vec3 sample_spherical_triangle(const SphericalTriangle& t, Vec2 u) {
     const Vec3 towards_c_sub = cross(cross(b, c_sub), b);
     const double away = dot(towards_c_sub, towards_c_sub);
     if (!(away > 0)) return b;  // c' is b (or opposite it): the arc is a point
-    return normalize(
-        b * z + towards_c_sub *
-                    (std::sqrt(positive_part(one_minus_z * (2 - one_minus_z))) / std::sqrt(away)));
+    // towards_c_sub is orthogonal to b, so the sum is a unit vector without normalising.
+    return b * z + towards_c_sub * std::sqrt(positive_part(one_minus_z * (2 - one_minus_z)) / away);
 }
 
 }  // namespace drt
