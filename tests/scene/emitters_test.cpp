@@ -80,10 +80,19 @@ std::optional<std::uint32_t> triangle_at(const Vec3& point, double slack = 0) {
     return std::nullopt;
 }
 
-// Viewpoints: just under the quad, under it further off, beside it almost in its plane, far
-// above (under 1e-4 sr: sampled by area), and above its other side.
-const std::array<Vec3, 5> kViews = {Vec3{0.2, 0.9, 0.1}, Vec3{0.5, -1, 0.3}, Vec3{3, 0.95, 0},
-                                    Vec3{0.1, 300, 0.2}, Vec3{-0.3, 1.5, 0.4}};
+// Viewpoints: just under the quad, under it further off, beside it almost in its plane, above
+// its other side, and farther from its plane than its edges are long, where it is sampled by
+// area: 5 under it and far above (under 1e-4 sr besides).
+const std::array<Vec3, 6> kViews = {Vec3{0.2, 0.9, 0.1},  Vec3{0.5, -1, 0.3},  Vec3{3, 0.95, 0},
+                                    Vec3{-0.3, 1.5, 0.4}, Vec3{0.2, -4, -0.1}, Vec3{0.1, 300, 0.2}};
+
+// Whether the triangle is sampled by solid angle from x: x nearer its plane than its longest
+// edge is long, and the solid angle at least 1e-4 sr.
+bool by_solid_angle(const Vec3& x, const std::array<Vec3, 3>& p, double omega) {
+    double longest = 0;
+    for (int k = 0; k < 3; ++k) longest = std::max(longest, length(p[(k + 1) % 3] - p[k]));
+    return std::abs(x.y - 1) < longest && omega >= 1e-4;
+}
 
 double solid_angle(const Vec3& x, const std::array<Vec3, 3>& p) {
     const Vec3 a = normalize(p[0] - x), b = normalize(p[1] - x), c = normalize(p[2] - x);
@@ -111,7 +120,8 @@ TEST(Emitters, SampledDirectionsReachTheMeshWithTheDensityPdfGives) {
 }
 
 // Triangle t's pick probability (its share of the area) over the solid angle it subtends; by
-// area beyond 1e-4 sr, where the two agree to 1e-3 for a triangle seen face on.
+// area farther off, where the two agree to 1e-3 for a triangle seen face on 300 away and to
+// 0.05 five away (measured: 8.6e-6 and 0.029).
 TEST(Emitters, TrianglesDensityIsItsPickOverItsSolidAngle) {
     const auto q = quad_scene();
     const double total = area(corners(0)) + area(corners(1));
@@ -122,13 +132,13 @@ TEST(Emitters, TrianglesDensityIsItsPickOverItsSolidAngle) {
             const Vec3 centroid = (p[0] + p[1] + p[2]) / 3;
             const double omega = solid_angle(x, p);
             const double pdf = q->emitters->pdf(0, x, centroid, kUp, t, 0);
-            if (omega >= 1e-4) {
+            if (by_solid_angle(x, p, omega)) {
                 EXPECT_NEAR(pdf, pick / omega, 1e-9 * pdf) << t << " " << x.y;
             } else {
                 const Vec3 v = centroid - x;
                 const double by_area = dot(v, v) / (total * std::abs(dot(kUp, normalize(v))));
                 EXPECT_NEAR(pdf, by_area, 1e-12 * pdf) << t << " " << x.y;
-                EXPECT_NEAR(pdf, pick / omega, 1e-3 * pdf) << t << " " << x.y;
+                EXPECT_NEAR(pdf, pick / omega, (x.y > 10 ? 1e-3 : 0.05) * pdf) << t << " " << x.y;
             }
         }
     }
@@ -235,10 +245,10 @@ Irradiance estimate(const Emitters& emitters, const Vec3& x, bool by_area, int n
 }
 
 // Under the triangle, 0.1 below it near a corner and 0.02 below it near an edge's middle, and
-// well under its centre: both estimates agree with Lambert's formula within four standard
-// errors, and the solid-angle one has a twentieth of area sampling's variance or less near the
-// triangle (measured: 1/430 and 1/6000) and half or less under its centre (measured: 1/16);
-// all it has left is the variation of the cosine at x.
+// 2 under its centre (nearer its plane than its longest edge, 2.8, is long): both estimates agree
+// with Lambert's formula within four standard errors, and the solid-angle one has a twentieth of
+// area sampling's variance or less near the triangle (measured: 1/430 and 1/6000) and half or less
+// under its centre (measured: 1/16); all it has left is the variation of the cosine at x.
 TEST(Emitters, IrradianceUnderATriangleIsLambertsWithLessVarianceThanByArea) {
     const auto single = quad_scene(1);
     const auto p = corners(0);
@@ -247,7 +257,7 @@ TEST(Emitters, IrradianceUnderATriangleIsLambertsWithLessVarianceThanByArea) {
         bool near;
     };
     for (const View& view : {View{{-0.8, 0.9, -0.85}, true}, View{{1.25, 0.98, 0}, true},
-                             View{{0.4, -2, -0.3}, false}}) {
+                             View{{0.4, -1, -0.3}, false}}) {
         const double expected = testing::triangle_irradiance(view.x, kUp, p[0], p[1], p[2]);
         const int n = 40000;
         const Irradiance solid = estimate(*single->emitters, view.x, false, n);

@@ -2,8 +2,9 @@
 // triangle mesh) and Falloff-1 point lights, as next-event estimation samples them. Spheres are
 // sampled by the solid angle they subtend; a mesh's triangle is picked by area (one emitted
 // radiance per mesh, so area is its power distribution) and then sampled by the solid angle it
-// subtends (sampling/spherical_triangle.h), or by area where that angle is too small or too
-// close to a hemisphere to be sampled soundly; a Falloff-1 point light is a point.
+// subtends (sampling/spherical_triangle.h) from points near it, by area from farther off or
+// where that angle is too small or too close to a hemisphere to be sampled soundly (the rule is
+// in emitters.cpp); a Falloff-1 point light is a point.
 // Emitting planes are infinite: they are seen by rays and found by scattered rays only. The
 // scene's environment, if any, is the last emitter, sampled by its own distribution
 // (environment.h) at an infinite distance.
@@ -46,6 +47,7 @@ class Emitters {
             std::array<Vec3, 3> corners;  // in the mesh's own coordinates, as the mesh has them
             Vec3 normal;                  // TriangleMesh::geometric_normal
             double pick = 0;              // its probability: its share of the mesh's area
+            double longest_edge2 = 0;     // the square of its longest edge's length
         };
         std::vector<Triangle> triangles;
         double area = 0;  // a sphere's or mesh's whole surface
