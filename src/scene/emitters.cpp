@@ -33,7 +33,7 @@ double triangle_area(const std::array<Vec3, 3>& p) {
 // A triangle is sampled by the solid angle it subtends from a point closer to its plane than its
 // longest edge is long: only there does area sampling's density in solid angle, d²/(area·cos),
 // vary much over the triangle; farther off it varies by a small factor (d³ over the triangle
-// from a point at height h ≥ every edge: under 1.4 below its middle) and area sampling is as
+// from a point at height h ≥ every edge: about 1.5 below its middle) and area sampling is as
 // good and half the cost. Solid-angle sampling also needs an angle between these bounds: below
 // 1e-4 sr (a triangle about 0.6° across, or one seen edge-on) the angle at a corner and the
 // arcs Arvo's mapping builds lose digits; within 0.1 sr of 2π the point is nearly on the
