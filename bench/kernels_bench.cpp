@@ -1,5 +1,5 @@
 // Micro-benchmarks of the kernels every ray runs through: ray-sphere and ray-plane tests, the
-// samplers' points and the spherical light's direction sampling.
+// samplers' points, the spherical light's direction sampling and an emitting triangle's.
 #include <benchmark/benchmark.h>
 
 #include <array>
@@ -8,7 +8,9 @@
 #include "bench_world.h"
 #include "drt/geometry/plane.h"
 #include "drt/sampling/sampler.h"
+#include "drt/scene/emitters.h"
 #include "drt/scene/light.h"
+#include "drt/scene/scene_loader.h"
 
 namespace drt::bench {
 namespace {
@@ -133,6 +135,28 @@ void BM_SphereLightSampleBatch(benchmark::State& state) {
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * u.size()));
 }
 BENCHMARK(BM_SphereLightSampleBatch);
+
+// A direction towards the Cornell box's lamp (one of its two triangles), from points in the
+// box below it: by the solid angle the triangle subtends (Arg 0), or from points so far off
+// (10⁵ above) that it subtends under 1e-4 sr and is sampled by area (Arg 1).
+void BM_EmittingTriangleSample(benchmark::State& state) {
+    const Scene scene = load_scene_from_string(R"(<Scene><Camera Ex="0" Ey="0" Ez="-1" Lx="0"
+        Ly="0" Lz="0" Fov="40"/><Materials><Lamp ker="17" keg="12" keb="4"/></Materials>
+        <Triangle Ax="213" Ay="548.8" Az="227" Bx="213" By="548.8" Bz="332" Cx="343" Cy="548.8"
+        Cz="332" Material="Lamp"/></Scene>)",
+                                               "bench.xml")
+                            .scene;
+    const Emitters emitters(scene);
+    const double lift = state.range(0) == 0 ? 0.0 : 1e5;
+    std::size_t i = 0;
+    for (auto _ : state) {
+        Vec3 x = point_in_cube(6, i % kRays, 540);
+        x.y += lift;
+        benchmark::DoNotOptimize(emitters.sample(0, x, {unit(7, i), unit(8, i)}, 0));
+        ++i;
+    }
+}
+BENCHMARK(BM_EmittingTriangleSample)->Arg(0)->Arg(1);
 
 }  // namespace
 }  // namespace drt::bench

@@ -161,9 +161,9 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
             } else if (emitter && strategy_ == Strategy::kLightOnly) {
                 weight = 0;
             } else if (emitter && strategy_ == Strategy::kMis) {
-                const double light =
-                    emitter_rays_[*emitter] *
-                    plan_.emitters.pdf(*emitter, from, surface.point, surface.normal, ray.time);
+                const double light = emitter_rays_[*emitter] *
+                                     plan_.emitters.pdf(*emitter, from, surface.point,
+                                                        surface.normal, hit->primitive, ray.time);
                 weight = power_heuristic(scatter_density, light);
             }
             result += throughput * m.emission * weight;

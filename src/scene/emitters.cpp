@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "drt/geometry/sphere.h"
+#include "drt/sampling/spherical_triangle.h"
 #include "drt/scene/light.h"
 
 namespace drt {
@@ -27,6 +28,32 @@ double one_minus_cos_max(double d2, double radius) {
 
 double triangle_area(const std::array<Vec3, 3>& p) {
     return 0.5 * length(cross(p[1] - p[0], p[2] - p[0]));
+}
+
+// A triangle is sampled by the solid angle it subtends from a point closer to its plane than its
+// longest edge is long: only there does area sampling's density in solid angle, d²/(area·cos),
+// vary much over the triangle; farther off it varies by a small factor (d³ over the triangle
+// from a point at height h ≥ every edge: about 1.5 below its middle) and area sampling is as
+// good and half the cost. Solid-angle sampling also needs an angle between these bounds: below
+// 1e-4 sr (a triangle about 0.6° across, or one seen edge-on) the angle at a corner and the
+// arcs Arvo's mapping builds lose digits; within 0.1 sr of 2π the point is nearly on the
+// triangle, the angles at its corners near π and their sines, by which the mapping divides,
+// are lost to rounding. Elsewhere the triangle is sampled by area.
+constexpr double kMinSolidAngle = 1e-4;
+constexpr double kMaxSolidAngle = 2 * kPi - 0.1;
+
+// The spherical triangle of t seen from the point at `offset` from the mesh's origin, if it is
+// to be sampled by solid angle. sample and pdf both decide by this one function, so that the
+// density a scattered ray is weighed with is the one the light sample would have had.
+std::optional<SphericalTriangle> by_solid_angle(const Emitters::Emitter::Triangle& t,
+                                                const Vec3& offset) {
+    const double height = dot(t.corners[0] - offset, t.normal);
+    if (!(height * height < t.longest_edge2)) return std::nullopt;
+    const SphericalTriangle s =
+        spherical_triangle(t.corners[0] - offset, t.corners[1] - offset, t.corners[2] - offset);
+    // NaN (a corner at the point) fails both tests.
+    if (s.area >= kMinSolidAngle && s.area <= kMaxSolidAngle) return s;
+    return std::nullopt;
 }
 
 }  // namespace
@@ -62,12 +89,22 @@ Emitters::Emitters(const Scene& scene) {
             e.path = shape.path;
             e.mesh = shape.mesh;
             for (std::uint32_t t = 0; t < shape.mesh->triangle_count(); ++t) {
-                e.area += triangle_area(shape.mesh->corners(t));
+                const auto corners = shape.mesh->corners(t);
+                const double area = triangle_area(corners);
+                e.area += area;
                 e.area_cdf.push_back(e.area);
+                double longest_edge2 = 0;
+                for (int k = 0; k < 3; ++k) {
+                    const Vec3 edge = corners[(k + 1) % 3] - corners[k];
+                    longest_edge2 = std::max(longest_edge2, dot(edge, edge));
+                }
+                e.triangles.push_back(
+                    {corners, shape.mesh->geometric_normal(t), area, longest_edge2});
             }
             if (!(e.area > 0)) continue;
             for (double& c : e.area_cdf) c /= e.area;
             e.area_cdf.back() = 1.0;
+            for (Emitter::Triangle& t : e.triangles) t.pick /= e.area;
             emitters_.push_back(std::move(e));
         }
     }
@@ -125,22 +162,36 @@ std::optional<EmitterSample> Emitters::sample(std::size_t i, const Vec3& x, Vec2
         }
         case Kind::kTriangles: {
             const auto& cdf = e.area_cdf;
-            const std::size_t k = std::min<std::size_t>(
-                std::upper_bound(cdf.begin(), cdf.end(), u.x) - cdf.begin(), cdf.size() - 1);
+            // One triangle (a <Triangle>) needs no search: u.x is then the triangle's own.
+            const std::size_t k =
+                cdf.size() == 1 ? 0
+                                : std::min<std::size_t>(
+                                      std::upper_bound(cdf.begin(), cdf.end(), u.x) - cdf.begin(),
+                                      cdf.size() - 1);
             const double lo = k == 0 ? 0.0 : cdf[k - 1];
             // The pick's share of u.x, stretched back over [0, 1): a well-spread u stays so.
             const double v = std::clamp((u.x - lo) / (cdf[k] - lo), 0.0, std::nextafter(1.0, 0.0));
-            const auto triangle = static_cast<std::uint32_t>(k);
-            const auto p = e.mesh->corners(triangle);
+            const Emitter::Triangle& t = e.triangles[k];
+            const Vec3 origin = e.path->at(time);
+            if (const auto spherical = by_solid_angle(t, x - origin)) {
+                const Vec3 dir = sample_spherical_triangle(*spherical, {v, u.y});
+                // Where dir meets the triangle's plane; dir lies within the triangle, which is
+                // not seen edge-on (its solid angle would be below the bound).
+                const double distance =
+                    dot(t.corners[0] - (x - origin), t.normal) / dot(dir, t.normal);
+                if (!(distance > 0)) return std::nullopt;
+                return EmitterSample{dir, distance, e.radiance, t.pick / spherical->area};
+            }
+            const auto& p = t.corners;
             const double su = std::sqrt(v);
             const double b1 = (1 - su), b2 = u.y * su;
-            const Vec3 point = e.path->at(time) + (p[0] * (1 - b1 - b2) + p[1] * b1 + p[2] * b2);
+            const Vec3 point = origin + (p[0] * (1 - b1 - b2) + p[1] * b1 + p[2] * b2);
             const Vec3 to_point = point - x;
             const double d2 = dot(to_point, to_point);
             if (!(d2 > 0)) return std::nullopt;
             const double d = std::sqrt(d2);
             const Vec3 dir = to_point / d;
-            const double cosine = std::abs(dot(e.mesh->geometric_normal(triangle), dir));
+            const double cosine = std::abs(dot(t.normal, dir));
             if (!(cosine > 0)) return std::nullopt;
             return EmitterSample{dir, d, e.radiance, d2 / (e.area * cosine)};
         }
@@ -154,7 +205,7 @@ std::optional<EmitterSample> Emitters::sample(std::size_t i, const Vec3& x, Vec2
 }
 
 double Emitters::pdf(std::size_t i, const Vec3& x, const Vec3& point, const Vec3& normal,
-                     double time) const {
+                     std::uint32_t primitive, double time) const {
     const Emitter& e = emitters_[i];
     switch (e.kind) {
         case Kind::kPoint:
@@ -166,6 +217,12 @@ double Emitters::pdf(std::size_t i, const Vec3& x, const Vec3& point, const Vec3
             return 1 / (2 * kPi * one_minus_cos_max(d2, e.radius));
         }
         case Kind::kTriangles: {
+            if (primitive >= e.triangles.size()) return 0;
+            const Emitter::Triangle& t = e.triangles[primitive];
+            if (const auto spherical = by_solid_angle(t, x - e.path->at(time))) {
+                return t.pick / spherical->area;
+            }
+            // Picked by area and sampled by area: the density of a point on the whole mesh.
             const Vec3 to_point = point - x;
             const double d2 = dot(to_point, to_point);
             const double cosine = std::abs(dot(normal, to_point)) / std::sqrt(d2);

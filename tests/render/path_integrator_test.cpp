@@ -14,6 +14,7 @@
 #include "drt/render/integrator.h"
 #include "drt/render/renderer.h"
 #include "drt/scene/scene_loader.h"
+#include "test_math.h"
 #include "test_meshes.h"
 #include "test_scenes.h"
 
@@ -295,8 +296,9 @@ struct Estimate {
     Color mean;
     double standard_error;  // of the mean's luminance
 };
-Estimate estimate(PathIntegrator::Strategy strategy, int n) {
-    const Scene scene = from_xml(floor_under_sphere("path", "random", 1, 1));
+Estimate estimate(PathIntegrator::Strategy strategy, int n,
+                  const std::string& xml = floor_under_sphere("path", "random", 1, 1)) {
+    const Scene scene = from_xml(xml);
     const RenderPlan plan = plan_render(scene);
     const Bvh bvh(scene.objects);
     const auto sampler = make_sampler("random");
@@ -327,6 +329,49 @@ TEST(PathIntegrator, ShadowRaysScatteredRaysAndTheirWeighingAgree) {
          {PathIntegrator::Strategy::kMis, PathIntegrator::Strategy::kLightOnly,
           PathIntegrator::Strategy::kScatterOnly}) {
         const Estimate e = estimate(strategy, n);
+        const double relative_error = e.standard_error / luminance(expected);
+        EXPECT_LT(relative_error, 0.004);
+        expect_relative(e.mean, expected, 5 * relative_error,
+                        "strategy " + std::to_string(static_cast<int>(strategy)));
+    }
+}
+
+// The floor point under a tilted emitting triangle that fills much of its sky, sampled by the
+// solid angle it subtends: its irradiance is Lambert's closed form for a polygon.
+const std::array<Vec3, 3> kTilted = {Vec3{-3, 1, -2}, Vec3{3, 1.5, -1}, Vec3{0, 2, 3}};
+
+std::string floor_under_triangle() {
+    std::string corners;
+    for (int k = 0; k < 3; ++k) {
+        const Vec3& p = kTilted[k];
+        const std::string name(1, char('A' + k));
+        corners += " " + name + "x=\"" + std::to_string(p.x) + "\" " + name + "y=\"" +
+                   std::to_string(p.y) + "\" " + name + "z=\"" + std::to_string(p.z) + "\"";
+    }
+    return R"(<Scene><Image Width="1" Height="1"/>
+      <Render Integrator="path" Samples="1" ShadowRays="1" Sampler="random"/>
+      <Camera Ex="30" Ey="4" Ez="0" Lx="0" Ly="0" Lz="0" Fov="0.001"/>
+      <Materials>
+        <Floor diffuse="0.9" kdr="0.5" kdg="0.25" kdb="1"/>
+        <Glow ker="2" keg="3" keb="4"/>
+      </Materials>
+      <Plane Px="0" Py="0" Pz="0" Vu="0" Vv="1" Vw="0" Material="Floor"/>
+      <Triangle)" +
+           corners + R"( Material="Glow"/></Scene>)";
+}
+
+// The same agreement for an emitting triangle: the light sample's density (the pick over the
+// triangle's solid angle) and the one a scattered ray is weighed with must be the same, or the
+// weighed estimate leaves the closed form.
+TEST(PathIntegrator, ShadowRaysScatteredRaysAndTheirWeighingAgreeForATriangle) {
+    const double irradiance =
+        testing::triangle_irradiance({0, 0, 0}, {0, 1, 0}, kTilted[0], kTilted[1], kTilted[2]);
+    const Color expected = Color{0.5 * 2, 0.25 * 3, 1 * 4} * (0.9 * irradiance / kPi);
+    const int n = 200000;
+    for (const auto strategy :
+         {PathIntegrator::Strategy::kMis, PathIntegrator::Strategy::kLightOnly,
+          PathIntegrator::Strategy::kScatterOnly}) {
+        const Estimate e = estimate(strategy, n, floor_under_triangle());
         const double relative_error = e.standard_error / luminance(expected);
         EXPECT_LT(relative_error, 0.004);
         expect_relative(e.mean, expected, 5 * relative_error,

@@ -34,4 +34,19 @@ inline double angle_between(const Vec3& a, const Vec3& b) {
     return std::atan2(length(cross(a, b)), dot(a, b));
 }
 
+// Irradiance at x, normal n, from a triangle of radiance 1 wholly above x's horizon: Lambert's
+// formula for a uniform polygon, E = ½ Σ θ_i n·(v_i × v_i+1)/|v_i × v_i+1| over its edges, v_i
+// the unit vectors to the corners and θ_i the angle between them; the winding only flips the sign.
+inline double triangle_irradiance(const Vec3& x, const Vec3& n, const Vec3& p0, const Vec3& p1,
+                                  const Vec3& p2) {
+    const Vec3 v[3] = {normalize(p0 - x), normalize(p1 - x), normalize(p2 - x)};
+    double sum = 0;
+    for (int i = 0; i < 3; ++i) {
+        const Vec3& a = v[i];
+        const Vec3& b = v[(i + 1) % 3];
+        sum += angle_between(a, b) * dot(n, normalize(cross(a, b)));
+    }
+    return 0.5 * std::abs(sum);
+}
+
 }  // namespace drt::testing

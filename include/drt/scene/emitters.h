@@ -1,12 +1,16 @@
 // The lights that are physical: emitting surfaces (a material's ker keg keb on a sphere or a
 // triangle mesh) and Falloff-1 point lights, as next-event estimation samples them. Spheres are
-// sampled by the solid angle they subtend, a mesh by area over its triangles (one emitted
-// radiance per mesh, so area is its power distribution), a Falloff-1 point light is a point.
+// sampled by the solid angle they subtend; a mesh's triangle is picked by area (one emitted
+// radiance per mesh, so area is its power distribution) and then sampled by the solid angle it
+// subtends (sampling/spherical_triangle.h) from points near it, by area from farther off or
+// where that angle is too small or too close to a hemisphere to be sampled soundly (the rule is
+// in emitters.cpp); a Falloff-1 point light is a point.
 // Emitting planes are infinite: they are seen by rays and found by scattered rays only. The
 // scene's environment, if any, is the last emitter, sampled by its own distribution
 // (environment.h) at an infinite distance.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <unordered_map>
@@ -38,7 +42,15 @@ class Emitters {
         double radius = 0;                 // a sphere's
         const TriangleMesh* mesh = nullptr;
         std::vector<double> area_cdf;  // a mesh's triangles by area, the last exactly 1
-        double area = 0;               // a sphere's or mesh's whole surface
+        // A mesh's triangles as sampling needs them, worked out once rather than per ray.
+        struct Triangle {
+            std::array<Vec3, 3> corners;  // in the mesh's own coordinates, as the mesh has them
+            Vec3 normal;                  // TriangleMesh::geometric_normal
+            double pick = 0;              // its probability: its share of the mesh's area
+            double longest_edge2 = 0;     // the square of its longest edge's length
+        };
+        std::vector<Triangle> triangles;
+        double area = 0;  // a sphere's or mesh's whole surface
         const Environment* environment = nullptr;
         // What next-event estimation shares shadow rays by, in the units of a thesis light's
         // luminance(I): luminance(I) for a point, luminance(radiance)·area/(4π) for a surface
@@ -60,9 +72,10 @@ class Emitters {
     // nothing when the sample cannot reach x (an edge-on triangle).
     std::optional<EmitterSample> sample(std::size_t i, const Vec3& x, Vec2 u, double time) const;
     // The density per unit solid angle with which sample(i, x, ·, time) picks the direction
-    // from x to `point` on the emitter, whose geometric normal there is `normal`.
+    // from x to `point` on the emitter, whose geometric normal there is `normal`, on its
+    // primitive `primitive` (a mesh's triangle: Hit::primitive).
     double pdf(std::size_t i, const Vec3& x, const Vec3& point, const Vec3& normal,
-               double time) const;
+               std::uint32_t primitive, double time) const;
     // Which emitter an object is, if it is sampled as one.
     std::optional<std::size_t> index_of(const Object* object) const;
     // Which emitter the environment is, if there is one.
