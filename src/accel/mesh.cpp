@@ -34,7 +34,9 @@ Object::SurfaceCoordinates Mesh::locate(const Ray& ray, const Hit& hit, SurfaceH
     // mesh's own coordinates, whatever distance the ray came from.
     surface.point = origin + (a * w.b0 + b * w.b1 + c * w.b2);
     surface.normal = mesh_->geometric_normal(hit.primitive);
-    surface.shading_normal = mesh_->shading_normal(hit.primitive, w);
+    // A flat mesh's shading normal is the face's own, computed once.
+    surface.shading_normal =
+        mesh_->smooth() ? mesh_->shading_normal(hit.primitive, w) : surface.normal;
     if (mesh_->smooth()) {
         surface.light_point = origin + mesh_->lifted(hit.primitive, w);
         surface.light_normal = surface.shading_normal;
