@@ -7,6 +7,7 @@
 
 #include "bench_world.h"
 #include "drt/geometry/plane.h"
+#include "drt/sampling/distribution_2d.h"
 #include "drt/sampling/sampler.h"
 #include "drt/scene/emitters.h"
 #include "drt/scene/light.h"
@@ -157,6 +158,19 @@ void BM_EmittingTriangleSample(benchmark::State& state) {
     }
 }
 BENCHMARK(BM_EmittingTriangleSample)->Arg(0)->Arg(1);
+
+// Building the sampling distribution of a full-size 4096 x 2048 environment map (its luminance
+// already computed): a cost paid once per render, at start-up.
+void BM_Distribution2DBuild(benchmark::State& state) {
+    constexpr std::size_t nu = 4096, nv = 2048;
+    std::vector<float> f(nu * nv);
+    for (std::size_t k = 0; k < f.size(); ++k) f[k] = static_cast<float>((k * 2654435761u) % 1000);
+    for (auto _ : state) {
+        const Distribution2D d(f, nu, nv);
+        benchmark::DoNotOptimize(d.integral());
+    }
+}
+BENCHMARK(BM_Distribution2DBuild)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace drt::bench
