@@ -107,9 +107,7 @@ void AovTracer::pixel_mean(int x, int y, const PixelSample& s, std::span<const A
         const SurfaceHit surface = surface_of(ray, *hit, 0, camera_, scene_.settings.samples);
         // Facing the camera as the integrators face it: the side the ray arrives on, and the
         // geometric normal where a bump tilted the shading normal past the viewer.
-        const bool outside = dot(ray.dir, surface.normal) < 0;
-        Vec3 shading = outside ? surface.shading_normal : -surface.shading_normal;
-        if (dot(shading, ray.dir) >= 0) shading = outside ? surface.normal : -surface.normal;
+        const Vec3 shading = facing_normals(surface, ray.dir).shading;
         const Material& m = hit->object->material();
         if (m.has_diffuse()) albedo += m.diffuse * surface.kd;
         normal = normal + shading;

@@ -117,14 +117,10 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
     const SurfaceHit surface = surface_of(ray, *hit, depth, camera_, scene_.settings.samples);
     // Face both normals towards the incoming ray: planes are two-sided, and a ray inside a
     // sphere sees its inner side.
-    const bool outside = dot(ray.dir, surface.normal) < 0;
-    const Vec3 geometric = outside ? surface.normal : -surface.normal;
-    Vec3 shading = outside ? surface.shading_normal : -surface.shading_normal;
-    if (dot(shading, ray.dir) >= 0) shading = geometric;  // bump tilted it past the viewer
+    const auto [outside, geometric, shading, above] = facing_normals(surface, ray.dir);
 
     Color result = m.emission;  // seen from either side
     if (m.has_diffuse()) {
-        const Vec3 above = outside ? surface.light_normal : -surface.light_normal;
         Color light = scene_.ambient + direct_light(surface.light_point, above, shading, ray.time,
                                                     s, depth, work.counts);
         // Light through glass and off mirrors: shadow rays never pass them, so it is counted

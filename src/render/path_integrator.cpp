@@ -146,10 +146,7 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
 
         const Material& m = hit->object->material();
         const SurfaceHit surface = hit->object->surface_at(ray, *hit);
-        const bool outside = dot(ray.dir, surface.normal) < 0;
-        const Vec3 geometric = outside ? surface.normal : -surface.normal;
-        Vec3 shading = outside ? surface.shading_normal : -surface.shading_normal;
-        if (dot(shading, ray.dir) >= 0) shading = geometric;
+        const auto [outside, geometric, shading, above] = facing_normals(surface, ray.dir);
 
         if (m.emits()) {
             double weight = 1;
@@ -184,7 +181,6 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
         const double diffuse_pick = diffuse_weight / total;
 
         if (diffuse_weight > 0) {
-            const Vec3 above = outside ? surface.light_normal : -surface.light_normal;
             Color light = next_event(surface.light_point, above, shading, ray.time, s, depth,
                                      diffuse_pick, counts);
             if (photons_) light += photons_->caustic(s.seed, s.pass(), surface.point, geometric);

@@ -331,10 +331,9 @@ bool PhotonMaps::trace_one(std::uint64_t key, Photon& out) const {
         if (!hit) return false;
         const Material& m = hit->object->material();
         const SurfaceHit surface = hit->object->surface_at(ray, *hit);
-        const bool outside = dot(ray.dir, surface.normal) < 0;
-        const Vec3 geometric = outside ? surface.normal : -surface.normal;
-        Vec3 shading = outside ? surface.shading_normal : -surface.shading_normal;
-        if (dot(shading, ray.dir) >= 0) shading = geometric;
+        const FacingNormals facing = facing_normals(surface, ray.dir);
+        const bool outside = facing.outside;
+        const Vec3 &geometric = facing.geometric, &shading = facing.shading;
 
         // The parts are picked as the path integrator picks them; a diffuse pick stores the
         // photon (divided by the pick's probability) and ends it.

@@ -48,6 +48,24 @@ struct SurfaceHit {
     Vec3 light_point, light_normal;
 };
 
+// A hit's normals turned to the side a ray of direction `dir` arrived on, as every integrator
+// shades them: `outside` when that is the side `normal` points to.
+struct FacingNormals {
+    bool outside;
+    Vec3 geometric;
+    // The shading normal, or the geometric one where a bump tilted it past the viewer.
+    Vec3 shading;
+    Vec3 light;  // light_normal, which says which lights are above
+};
+
+inline FacingNormals facing_normals(const SurfaceHit& surface, const Vec3& dir) {
+    const bool outside = dot(dir, surface.normal) < 0;
+    const Vec3 geometric = outside ? surface.normal : -surface.normal;
+    Vec3 shading = outside ? surface.shading_normal : -surface.shading_normal;
+    if (dot(shading, dir) >= 0) shading = geometric;
+    return {outside, geometric, shading, outside ? surface.light_normal : -surface.light_normal};
+}
+
 // A sphere as the BVH stores it: the BVH splits its path into one piece per segment, each bounded
 // over that segment's time span only.
 struct SphereShape {
