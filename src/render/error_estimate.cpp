@@ -53,7 +53,11 @@ Color strata_spread(std::span<const Vec2> positions, std::span<const Color> samp
     // ties by index, so the order is a pure function of the samples: dealt into their bands in
     // index order, then each band (about sqrt(n) samples) sorted on its own, which costs far less
     // than sorting all n at once.
-    auto& [band, start, order] = scratch;
+    // (References, not a structured binding: clang 14, the fuzz build's compiler, cannot capture
+    // a binding in the lambda below.)
+    auto& band = scratch.band;
+    auto& start = scratch.start;
+    auto& order = scratch.order;
     band.resize(n);
     order.resize(n);
     const auto differences = [&](std::size_t bands, auto across, auto along) {
