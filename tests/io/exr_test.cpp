@@ -166,6 +166,33 @@ TEST_F(ExrTest, AnImageWithoutColourChannelsIsRefused) {
     }
 }
 
+// An attribute that claims more bytes than the file holds is refused before OpenEXR, which would
+// first make room for all of them (a 2 GB string from a file of 40 bytes, found by fuzzing).
+TEST(ExrDecode, AnAttributeLargerThanTheFileIsRefusedBeforeOpenExrReadsIt) {
+    std::vector<unsigned char> data{0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0};
+    for (const char c : std::string("comments")) data.push_back(static_cast<unsigned char>(c));
+    data.push_back(0);
+    for (const char c : std::string("string")) data.push_back(static_cast<unsigned char>(c));
+    data.insert(data.end(), {0, 0xff, 0xff, 0xff, 0x7f, 'a', 'b', 0});
+    try {
+        decode_exr(data, "claims.exr");
+        FAIL() << "no exception";
+    } catch (const ImageError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "claims.exr: OpenEXR attribute comments claims "
+                  "2147483647 bytes, more than the file holds");
+    }
+    // The same attribute with the size it has is only an incomplete header to OpenEXR.
+    data[data.size() - 7] = 3, data[data.size() - 6] = data[data.size() - 5] = 0;
+    data[data.size() - 4] = 0;
+    try {
+        decode_exr(data, "claims.exr");
+        FAIL() << "no exception";
+    } catch (const ImageError& e) {
+        EXPECT_EQ(std::string(e.what()).find("claims "), std::string::npos) << e.what();
+    }
+}
+
 // OpenEXR throws its own exceptions for bad data; every one must arrive as an ImageError naming
 // the file, whether the file is cut short anywhere or has any byte changed.
 TEST_F(ExrTest, TruncatedOrCorruptFilesThrowImageErrors) {
