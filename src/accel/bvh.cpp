@@ -88,9 +88,27 @@ Bvh::Bvh(const std::vector<std::unique_ptr<Object>>& objects) {
         }
         for (const MeshShape& shape : shapes.meshes) {
             if (shape.mesh->triangle_count() == 0) continue;
+            // A part of a shared mesh already entered is only told which object it is.
+            if (shape.part != MeshShape::kWhole) {
+                const auto shared = std::ranges::find_if(meshes_, [&](const MeshData& m) {
+                    return m.mesh == shape.mesh && !m.part_objects.empty();
+                });
+                if (shared != meshes_.end()) {
+                    if (shape.part >= shared->part_objects.size())
+                        shared->part_objects.resize(shape.part + 1, kNoObject);
+                    shared->part_objects[shape.part] = object;
+                    continue;
+                }
+            }
             const Bounds local = shape.mesh->bounds();
             const auto index = static_cast<std::uint32_t>(meshes_.size());
             meshes_.push_back({shape.mesh, local.centre()});
+            if (shape.part != MeshShape::kWhole) {
+                const auto parts = shape.mesh->parts();
+                meshes_.back().part_objects.assign(
+                    std::max(*std::ranges::max_element(parts), shape.part) + 1, kNoObject);
+                meshes_.back().part_objects[shape.part] = object;
+            }
             const double radius = length(local.extent()) * 0.5;
             const MotionPath& path = *shape.path;
             if (!path.moves()) {
@@ -254,6 +272,14 @@ std::optional<double> Bvh::hit_segment(const Primitive& p, const Ray& ray, doubl
     }
 }
 
+std::uint32_t Bvh::object_of(const Primitive& p, std::uint32_t triangle) const {
+    if (!is_mesh(p.kind)) return p.object;
+    const MeshData& data = meshes_[p.index];
+    if (data.part_objects.empty()) return p.object;
+    const std::uint32_t object = data.part_objects[data.mesh->parts()[triangle]];
+    return object == kNoObject ? p.object : object;
+}
+
 template <bool kAnyHit>
 bool Bvh::traverse(const Ray& ray, Interval& range, std::uint64_t planes, Nearest& nearest) const {
     const double origin_scale = max_abs_component(ray.origin);
@@ -278,7 +304,8 @@ bool Bvh::traverse(const Ray& ray, Interval& range, std::uint64_t planes, Neares
             const Primitive& p = primitives_[i];
             if (auto t = hit<kAnyHit>(p, ray, origin_scale, range, triangle, uv)) {
                 if constexpr (kAnyHit) return true;
-                found = true, nearest = {p.object, is_mesh(p.kind) ? triangle : p.index, uv};
+                found = true,
+                nearest = {object_of(p, triangle), is_mesh(p.kind) ? triangle : p.index, uv};
                 range.max = *t;
             }
         }

@@ -15,15 +15,41 @@ std::vector<Vec3> shifted(std::vector<Vec3> points, const Vec3& by) {
 }  // namespace
 
 Mesh::Mesh(std::shared_ptr<const TriangleMesh> mesh, const std::vector<Vec3>& translations,
-           const Material& material, SurfaceDetail detail)
+           const Material& material, SurfaceDetail detail, std::uint32_t part)
     : Object(material, std::move(detail)),
       mesh_(std::move(mesh)),
-      path_(shifted(translations, mesh_->origin())) {}
+      path_(shifted(translations, mesh_->origin())),
+      part_(mesh_->parts().empty() ? MeshShape::kWhole : part) {
+    if (part_ == MeshShape::kWhole) {
+        bounds_ = mesh_->bounds();
+        return;
+    }
+    for (std::uint32_t t = 0; t < mesh_->triangle_count(); ++t) {
+        if (mesh_->parts()[t] != part_) continue;
+        for (const Vec3& p : mesh_->corners(t)) bounds_.grow(p);
+    }
+}
 
 std::optional<Hit> Mesh::intersect(const Ray& ray, Interval range) const {
-    const auto hit = mesh_->intersect(ray_in_mesh(ray, path_.at(ray.time)), range);
-    if (!hit) return std::nullopt;
-    return Hit{hit->t, this, hit->triangle, {hit->b.b1, hit->b.b2}};
+    const Ray local = ray_in_mesh(ray, path_.at(ray.time));
+    if (part_ == MeshShape::kWhole) {
+        const auto hit = mesh_->intersect(local, range);
+        if (!hit) return std::nullopt;
+        return Hit{hit->t, this, hit->triangle, {hit->b.b1, hit->b.b2}};
+    }
+    // One part of a shared mesh, tested alone: its triangles one by one with the test the
+    // mesh's tree runs (the BVH enters the tree once for all parts instead).
+    const ShearedRay sheared(local);
+    std::optional<Hit> nearest;
+    for (std::uint32_t t = 0; t < mesh_->triangle_count(); ++t) {
+        if (mesh_->parts()[t] != part_) continue;
+        const auto [a, b, c] = mesh_->corners(t);
+        if (const auto hit = intersect_triangle(sheared, a, b, c, range)) {
+            range.max = hit->t;
+            nearest = Hit{hit->t, this, t, {hit->b.b1, hit->b.b2}};
+        }
+    }
+    return nearest;
 }
 
 Object::SurfaceCoordinates Mesh::locate(const Ray& ray, const Hit& hit, SurfaceHit& surface) const {

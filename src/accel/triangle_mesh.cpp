@@ -103,6 +103,7 @@ void TriangleMesh::take(const ObjMesh& obj, const MeshTransform& transform, bool
 
     const std::size_t corners = obj.position_indices.size();
     triangles_.reserve(corners / 3);
+    const bool parted = !obj.triangle_materials.empty();
     for (std::size_t c = 0; c < corners; c += 3) {
         const std::uint32_t* p = &obj.position_indices[c];
         // Zero area is the file's: rounding to float may move its corners off their line.
@@ -116,6 +117,7 @@ void TriangleMesh::take(const ObjMesh& obj, const MeshTransform& transform, bool
         }
         const std::uint32_t* n = &obj.normal_indices[c];
         triangles_.push_back({vertex(p[0], n[0]), vertex(p[1], n[1]), vertex(p[2], n[2])});
+        if (parted) parts_.push_back(obj.triangle_materials[c / 3]);
         if (!obj.texcoord_indices.empty()) {
             std::array<float, 6> uv{};
             for (std::size_t k = 0; k < 3; ++k) {
@@ -204,7 +206,7 @@ std::size_t TriangleMesh::bytes() const {
     return positions_.capacity() * sizeof(Float3) + normals_.capacity() * sizeof(Float3) +
            triangles_.capacity() * sizeof(triangles_[0]) +
            texcoords_.capacity() * sizeof(texcoords_[0]) + corners_.capacity() * sizeof(float) +
-           tree_.memory() + sizeof(*this);
+           parts_.capacity() * sizeof(parts_[0]) + tree_.memory() + sizeof(*this);
 }
 
 void TriangleMesh::build_hierarchy(int threads) {
@@ -222,6 +224,12 @@ void TriangleMesh::build_hierarchy(int threads) {
         uv_ordered.reserve(texcoords_.size());
         for (const std::uint32_t t : tree.order) uv_ordered.push_back(texcoords_[t]);
         texcoords_ = std::move(uv_ordered);
+    }
+    if (!parts_.empty()) {
+        std::vector<std::uint32_t> parts_ordered;
+        parts_ordered.reserve(parts_.size());
+        for (const std::uint32_t t : tree.order) parts_ordered.push_back(parts_[t]);
+        parts_ = std::move(parts_ordered);
     }
     order_vertices_by_leaves();
     make_corner_arrays();

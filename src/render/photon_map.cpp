@@ -71,7 +71,7 @@ double default_photon_radius(const Scene& scene) {
             bounds.grow(c - r).grow(c + r);
         }
         for (const MeshShape& m : shapes.meshes) {
-            const Bounds b = m.mesh->bounds();
+            const Bounds b = m.bounds;
             if (b.empty()) continue;
             const Vec3 origin = m.path->at(0);
             bounds.grow(origin + b.lo).grow(origin + b.hi);
@@ -177,7 +177,7 @@ PhotonMaps::PhotonMaps(const Scene& scene, const RenderPlan& plan, const Bvh& bv
             targets_.push_back({s.path->at(0), whole ? kInfinity : s.radius});
         }
         for (const MeshShape& mesh : shapes.meshes) {
-            const Bounds b = mesh.mesh->bounds();
+            const Bounds b = mesh.bounds;
             if (b.empty()) continue;
             targets_.push_back(
                 {mesh.path->at(0) + b.centre(), whole ? kInfinity : length(b.extent()) / 2});

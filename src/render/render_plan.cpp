@@ -149,7 +149,7 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
                 out << "emitting sphere of radius " << e.radius;
                 break;
             case Emitters::Kind::kTriangles:
-                out << "emitting triangles (" << e.mesh->triangle_count() << ")";
+                out << "emitting triangles (" << e.triangles.size() << ")";
                 break;
             case Emitters::Kind::kEnvironment:
                 out << "environment map, intensity " << e.environment->intensity();

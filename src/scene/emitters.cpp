@@ -88,7 +88,14 @@ Emitters::Emitters(const Scene& scene) {
             e.object = object.get();
             e.path = shape.path;
             e.mesh = shape.mesh;
+            if (shape.part != MeshShape::kWhole) {
+                e.index_of_triangle.assign(shape.mesh->triangle_count(), Emitter::kNotEmitting);
+            }
             for (std::uint32_t t = 0; t < shape.mesh->triangle_count(); ++t) {
+                if (shape.part != MeshShape::kWhole) {
+                    if (shape.mesh->parts()[t] != shape.part) continue;
+                    e.index_of_triangle[t] = static_cast<std::uint32_t>(e.triangles.size());
+                }
                 const auto corners = shape.mesh->corners(t);
                 const double area = triangle_area(corners);
                 e.area += area;
@@ -217,6 +224,10 @@ double Emitters::pdf(std::size_t i, const Vec3& x, const Vec3& point, const Vec3
             return 1 / (2 * kPi * one_minus_cos_max(d2, e.radius));
         }
         case Kind::kTriangles: {
+            if (!e.index_of_triangle.empty()) {
+                if (primitive >= e.index_of_triangle.size()) return 0;
+                primitive = e.index_of_triangle[primitive];
+            }
             if (primitive >= e.triangles.size()) return 0;
             const Emitter::Triangle& t = e.triangles[primitive];
             if (const auto spherical = by_solid_angle(t, x - e.path->at(time))) {

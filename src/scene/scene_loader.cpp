@@ -857,15 +857,17 @@ class SceneReader {
 
     // Triangles and meshes (docs/scene-format.md, "Meshes").
 
-    // The <Triangle>s of one material and one surface become one mesh (a scene of many pays a
-    // mesh's per-ray set-up once instead of once per triangle), built when every one is read
-    // (build_triangle_groups), in the place of the group's first among the scene's objects.
+    // The <Triangle>s of one material and one surface are one object, in the place of the
+    // group's first among the scene's objects; all the groups are parts of one mesh (a ray pays
+    // a mesh's set-up once, not once per triangle or per material), built when every triangle
+    // is read (build_triangle_groups).
     struct TriangleGroup {
         std::string material;
         SurfaceSpec surface;
         std::vector<std::array<Vec3, 3>> corners;
         std::vector<const XMLElement*> elements;  // per triangle, for messages
         std::shared_ptr<const TriangleMesh> mesh;
+        std::uint32_t part = MeshShape::kWhole;  // the group's part of the mesh
     };
 
     void read_triangle(const XMLElement& e) {
@@ -896,16 +898,20 @@ class SceneReader {
         triangle_groups_.push_back(made);
         pending_.push_back({&e, std::move(material), std::move(surface),
                             [group = std::move(made)](const Material& m, SurfaceDetail d) {
-                                return std::make_unique<Mesh>(
-                                    group->mesh, std::vector<Vec3>{Vec3{}}, m, std::move(d));
+                                return std::make_unique<Mesh>(group->mesh,
+                                                              std::vector<Vec3>{Vec3{}}, m,
+                                                              std::move(d), group->part);
                             }});
     }
 
-    // The meshes of the <Triangle> groups. A triangle that single precision cannot hold about its
-    // group's origin (a small one far from the others) is an object of its own, as it was before
-    // triangles were grouped: it is dropped with a warning only if it cannot be held even so.
+    // The mesh of the <Triangle> groups, one part each (when there are several). A triangle that
+    // single precision cannot hold about the mesh's origin (a small one far from the others) is
+    // an object of its own, as it was before triangles were grouped: it is dropped with a
+    // warning only if it cannot be held even so.
     void build_triangle_groups() {
+        if (triangle_groups_.empty()) return;
         const auto mesh_of = [this](const XMLElement& e, std::span<const std::array<Vec3, 3>> t,
+                                    std::vector<std::uint32_t> parts,
                                     const MeshTransform& transform) {
             ObjMesh obj;
             for (const auto& corners : t) {
@@ -915,37 +921,47 @@ class SceneReader {
                                             {first, first + 1, first + 2});
             }
             obj.normal_indices.assign(obj.position_indices.size(), ObjMesh::kNoNormal);
+            obj.triangle_materials = std::move(parts);
             Attributes in(e, context_);
             return build_mesh(in, std::move(obj), transform, false);
         };
+        Bounds box;
         for (const auto& group : triangle_groups_) {
-            Bounds box;
             for (const auto& corners : group->corners) {
                 for (const Vec3& p : corners) box.grow(p);
             }
-            MeshTransform transform;
-            transform.origin = box.centre();
-            std::vector<std::array<Vec3, 3>> kept;
-            for (std::size_t i = 0; i < group->corners.size(); ++i) {
-                const auto& [a, b, c] = group->corners[i];
-                const XMLElement& e = *group->elements[i];
+        }
+        MeshTransform transform;
+        transform.origin = box.centre();
+        const bool parted = triangle_groups_.size() > 1;
+        std::vector<std::array<Vec3, 3>> kept;
+        std::vector<std::uint32_t> parts;
+        for (std::uint32_t part = 0; part < triangle_groups_.size(); ++part) {
+            TriangleGroup& group = *triangle_groups_[part];
+            if (parted) group.part = part;
+            for (std::size_t i = 0; i < group.corners.size(); ++i) {
+                const auto& [a, b, c] = group.corners[i];
+                const XMLElement& e = *group.elements[i];
                 if (collinear(a, b, c) || TriangleMesh::holds(a, b, c, *transform.origin)) {
-                    kept.push_back(group->corners[i]);
+                    kept.push_back(group.corners[i]);
+                    if (parted) parts.push_back(part);
                     continue;
                 }
-                auto mesh = mesh_of(e, std::span(&group->corners[i], 1), MeshTransform{});
+                auto mesh = mesh_of(e, std::span(&group.corners[i], 1), {}, MeshTransform{});
                 if (mesh->collapsed() > 0) {
                     context_.warn(e, "<Triangle> too thin for single precision dropped");
                     continue;
                 }
-                pending_.push_back({&e, group->material, group->surface,
+                pending_.push_back({&e, group.material, group.surface,
                                     [mesh = std::move(mesh)](const Material& m, SurfaceDetail d) {
                                         return std::make_unique<Mesh>(
                                             mesh, std::vector<Vec3>{Vec3{}}, m, std::move(d));
                                     }});
             }
-            group->mesh = mesh_of(*group->elements.front(), kept, transform);
         }
+        const auto mesh =
+            mesh_of(*triangle_groups_.front()->elements.front(), kept, std::move(parts), transform);
+        for (const auto& group : triangle_groups_) group->mesh = mesh;
     }
 
     void read_mesh(const XMLElement& e) {
@@ -982,6 +998,7 @@ class SceneReader {
             return;
         }
         if (!reads_uv(surface)) drop_texcoords(obj);
+        obj.triangle_materials.clear();  // one material for all: the file's make no parts
         auto mesh = build_mesh(in, std::move(obj), transform, smooth);
         if (const std::size_t n = mesh->dropped(); n > 0) {
             context_.warn(e, std::to_string(n) + (n == 1 ? " triangle" : " triangles") +

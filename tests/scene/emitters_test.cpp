@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "drt/accel/mesh.h"
+#include "drt/scene/scene_loader.h"
 #include "test_math.h"
 #include "test_meshes.h"
 #include "test_scenes.h"
@@ -117,6 +118,38 @@ TEST(Emitters, SampledDirectionsReachTheMeshWithTheDensityPdfGives) {
             ASSERT_NEAR(s->pdf, pdf, 1e-9 * pdf) << i;
         }
     }
+}
+
+// An emitting part of a shared mesh (the <Triangle>s of a scene, one part per material) is
+// sampled on its own triangles only: every direction reaches the lamp, never the floor beside
+// it in the same mesh, and a hit on the floor's triangle has density 0 from the lamp.
+TEST(Emitters, AnEmittingPartOfASharedMeshSamplesOnlyItsOwnTriangles) {
+    const LoadedScene loaded = load_scene_from_string(R"(<Scene>
+        <Camera Ex="0" Ey="0" Ez="-5" Lx="0" Ly="0" Lz="0" Fov="40"/>
+        <Materials><Lamp ker="1" keg="1" keb="1"/><Floor diffuse="1"/></Materials>
+        <Triangle Ax="-1" Ay="2" Az="-1" Bx="1" By="2" Bz="-1" Cx="0" Cy="2" Cz="1"
+          Material="Lamp"/>
+        <Triangle Ax="-4" Ay="0" Az="-4" Bx="4" By="0" Bz="-4" Cx="0" Cy="0" Cz="4"
+          Material="Floor"/></Scene>)",
+                                                      "parts.xml");
+    ASSERT_EQ(loaded.scene.objects.size(), 2u);
+    const auto& lamp = dynamic_cast<const Mesh&>(*loaded.scene.objects[0]);
+    ASSERT_EQ(lamp.mesh().triangle_count(), 2u);
+    const Emitters emitters(loaded.scene);
+    ASSERT_EQ(emitters.size(), 1u);
+    EXPECT_EQ(emitters[0].triangles.size(), 1u);
+    EXPECT_DOUBLE_EQ(emitters[0].area, 2);
+    std::uint32_t lamp_triangle = 0, floor_triangle = 1;
+    if (lamp.mesh().parts()[0] != lamp.part()) std::swap(lamp_triangle, floor_triangle);
+    const Vec3 x{0.1, 1, 0.2};
+    for (std::uint64_t i = 0; i < 1000; ++i) {
+        const auto s = emitters.sample(0, x, {uniform(3, i), uniform(4, i)}, 0);
+        ASSERT_TRUE(s);
+        const Vec3 point = x + s->dir * s->distance;
+        ASSERT_NEAR(point.y, 2, 1e-9);
+        EXPECT_NEAR(emitters.pdf(0, x, point, kUp, lamp_triangle, 0), s->pdf, 1e-9 * s->pdf);
+    }
+    EXPECT_EQ(emitters.pdf(0, x, {0, 0, 0}, kUp, floor_triangle, 0), 0);
 }
 
 // Triangle t's pick probability (its share of the area) over the solid angle it subtends; by

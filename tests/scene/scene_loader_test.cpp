@@ -11,6 +11,7 @@
 
 #include <unistd.h>
 
+#include "drt/accel/bvh.h"
 #include "drt/accel/mesh.h"
 #include "drt/geometry/plane.h"
 #include "drt/geometry/sphere.h"
@@ -1005,7 +1006,16 @@ std::string triangle(const std::array<double, 9>& c, std::string_view attributes
 }
 
 // A mesh's per-ray set-up is paid once for all the <Triangle>s of one material and surface.
-TEST(SceneLoader, TrianglesOfOneMaterialAndSurfaceAreOneObject) {
+// The mesh triangles that are the object's own (its part of a shared mesh).
+std::vector<std::uint32_t> own_triangles(const Mesh& m) {
+    std::vector<std::uint32_t> own;
+    for (std::uint32_t t = 0; t < m.mesh().triangle_count(); ++t) {
+        if (m.part() == MeshShape::kWhole || m.mesh().parts()[t] == m.part()) own.push_back(t);
+    }
+    return own;
+}
+
+TEST(SceneLoader, TrianglesOfOneMaterialAndSurfaceAreOneObjectAndAllArePartsOfOneMesh) {
     const std::string body =
         "<Materials><Gray/><Red/></Materials>\n" +
         triangle({0, 0, 0, 1, 0, 0, 0, 1, 0}, "Material=\"Gray\"") +
@@ -1017,20 +1027,25 @@ TEST(SceneLoader, TrianglesOfOneMaterialAndSurfaceAreOneObject) {
         triangle({0, 0, 6, 1, 0, 6, 0, 1, 6}, "Material=\"Gray\" Au=\"0.5\"");
     const LoadedScene loaded = load(in_scene(body));
     EXPECT_TRUE(loaded.warnings.empty());
-    // In the order of each group's first triangle.
+    // In the order of each group's first triangle, each a part of the one mesh.
     ASSERT_EQ(loaded.scene.objects.size(), 4u);
-    EXPECT_EQ(mesh(loaded.scene, 0).mesh().triangle_count(), 3u);
+    for (std::size_t i = 0; i < 4; ++i) {
+        EXPECT_EQ(&mesh(loaded.scene, i).mesh(), &mesh(loaded.scene, 0).mesh());
+        EXPECT_EQ(mesh(loaded.scene, i).part(), i);
+    }
+    EXPECT_EQ(mesh(loaded.scene, 0).mesh().triangle_count(), 7u);
+    EXPECT_EQ(own_triangles(mesh(loaded.scene, 0)).size(), 3u);
     EXPECT_EQ(loaded.scene.objects[0]->material().name, "Gray");
-    EXPECT_EQ(mesh(loaded.scene, 1).mesh().triangle_count(), 2u);
+    EXPECT_EQ(own_triangles(mesh(loaded.scene, 1)).size(), 2u);
     EXPECT_EQ(loaded.scene.objects[1]->material().name, "Red");
-    EXPECT_EQ(mesh(loaded.scene, 2).mesh().triangle_count(), 1u);
+    EXPECT_EQ(own_triangles(mesh(loaded.scene, 2)).size(), 1u);
     EXPECT_TRUE(mesh(loaded.scene, 2).detail().texture);
-    EXPECT_EQ(mesh(loaded.scene, 3).mesh().triangle_count(), 1u);
-    // Every triangle keeps its corners, whichever the leaf order puts first.
+    EXPECT_EQ(own_triangles(mesh(loaded.scene, 3)).size(), 1u);
+    // Every triangle keeps its corners and its group, whichever the leaf order puts first.
     const Mesh& gray = mesh(loaded.scene, 0);
     const Vec3 o = gray.path().at(0);
     bool found = false;
-    for (std::uint32_t t = 0; t < 3; ++t) {
+    for (const std::uint32_t t : own_triangles(gray)) {
         const auto [a, b, c] = gray.mesh().corners(t);
         if (a + o == Vec3{5, 0, 5}) {
             found = true;
@@ -1039,6 +1054,36 @@ TEST(SceneLoader, TrianglesOfOneMaterialAndSurfaceAreOneObject) {
         }
     }
     EXPECT_TRUE(found);
+    // A part tested alone is hit only on its own triangles: the ray along z through every
+    // triangle meets the Red part first at z = 1, the Gray part at z = 0 and then z = 2.
+    const Ray ray{{0.25, 0.25, -1}, {0, 0, 1}};
+    const auto red = loaded.scene.objects[1]->intersect(ray, {0, kInfinity});
+    ASSERT_TRUE(red);
+    EXPECT_DOUBLE_EQ(red->t, 2);
+    EXPECT_EQ(red->object, loaded.scene.objects[1].get());
+    const auto gray_hit = loaded.scene.objects[0]->intersect(ray, {1.5, kInfinity});
+    ASSERT_TRUE(gray_hit);
+    EXPECT_DOUBLE_EQ(gray_hit->t, 3);
+    // The scene's BVH enters the mesh once and gives each hit to its triangle's part.
+    const Bvh bvh(loaded.scene.objects);
+    const double starts[] = {0, 1.5, 2.5, 3.5, 4.5};
+    const std::size_t owners[] = {0, 1, 0, 2, 1};
+    for (int k = 0; k < 5; ++k) {
+        const auto hit = bvh.intersect(ray, {starts[k], kInfinity});
+        ASSERT_TRUE(hit) << k;
+        EXPECT_DOUBLE_EQ(hit->t, k + 1) << k;
+        EXPECT_EQ(hit->object, loaded.scene.objects[owners[k]].get()) << k;
+    }
+}
+
+// A <Triangle> scene of one material is one mesh of one part, as before parts existed.
+TEST(SceneLoader, TrianglesOfOneGroupAreAMeshWithoutParts) {
+    const LoadedScene loaded = load(in_scene(
+        std::string(kGray) + "\n" + triangle({0, 0, 0, 1, 0, 0, 0, 1, 0}, "Material=\"Gray\"") +
+        triangle({0, 0, 1, 1, 0, 1, 0, 1, 1}, "Material=\"Gray\"")));
+    ASSERT_EQ(loaded.scene.objects.size(), 1u);
+    EXPECT_EQ(mesh(loaded.scene, 0).part(), MeshShape::kWhole);
+    EXPECT_TRUE(mesh(loaded.scene, 0).mesh().parts().empty());
 }
 
 // Warnings stay with their <Triangle>; one that the group's single precision would flatten

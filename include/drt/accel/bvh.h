@@ -71,7 +71,13 @@ class Bvh {
     struct MeshData {
         const TriangleMesh* mesh;
         Vec3 ball_offset;  // centre of the mesh's bounds in its own coordinates
+        // A mesh shared by several objects (MeshShape::part): the object (index into objects_)
+        // of each part, kNoObject for a part no object claimed; empty for a mesh of one object.
+        std::vector<std::uint32_t> part_objects = {};
     };
+    static constexpr std::uint32_t kNoObject = ~std::uint32_t{0};
+    // The object a hit on `triangle` of primitive p belongs to.
+    std::uint32_t object_of(const Primitive& p, std::uint32_t triangle) const;
     // A node is one cache line: its box, the time span of what it holds (rounded outwards to
     // float), and its primitives (leaf) or its second child (inner; the first follows it).
     struct alignas(64) Node {

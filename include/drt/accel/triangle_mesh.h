@@ -93,6 +93,10 @@ class TriangleMesh {
         const auto& t = texcoords_[triangle];
         return {Vec2{t[0], t[1]}, Vec2{t[2], t[3]}, Vec2{t[4], t[5]}};
     }
+    // Which part of the mesh each triangle belongs to, for a mesh that several objects share (one
+    // material each, as the <Triangle>s of a scene): the file's `triangle_materials` in the
+    // order of MeshHit::triangle; empty where the file has none.
+    std::span<const std::uint32_t> parts() const { return parts_; }
     // For a smooth mesh, the point at `b` moved out onto the curved surface that the vertex
     // normals describe (SurfaceHit::light_point in object.h).
     Vec3 lifted(std::uint32_t triangle, const Barycentrics& b) const;
@@ -133,6 +137,7 @@ class TriangleMesh {
     std::vector<std::array<std::uint32_t, 3>> triangles_;  // in leaf order
     // Per triangle, its corners' (u, v) in single precision; empty when the file has no `vt`.
     std::vector<std::array<float, 6>> texcoords_;
+    std::vector<std::uint32_t> parts_;  // per triangle; empty for a mesh of one part
     // A small mesh's float corners once more, one array a coordinate ([corner][axis], `stride_`
     // floats apart) in the leaf order, so that the float filter loads a lane of four neighbouring
     // triangles with one load from whichever array the ray's axis order asks for, instead of

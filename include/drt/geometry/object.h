@@ -78,9 +78,14 @@ struct PlaneShape {
 class TriangleMesh;
 // A triangle mesh enters the BVH whole (one piece per segment of its path), and the BVH's leaf
 // test runs the mesh's own hierarchy on the ray moved into the mesh's coordinates.
+// Several objects may share one mesh, each its own part of it (TriangleMesh::parts): the BVH
+// enters the mesh once and gives each hit to the object of the hit triangle's part.
 struct MeshShape {
-    const TriangleMesh* mesh;  // owned by the object, which outlives the BVH
-    const MotionPath* path;    // where the mesh's own origin is at each time
+    static constexpr std::uint32_t kWhole = ~std::uint32_t{0};
+    const TriangleMesh* mesh;     // owned by the object, which outlives the BVH
+    const MotionPath* path;       // where the mesh's own origin is at each time
+    std::uint32_t part = kWhole;  // the object's part of the mesh; kWhole: every triangle
+    Bounds bounds = {};           // of the object's triangles, in the mesh's coordinates
 };
 // An object's geometry in the typed forms the BVH tests inline (no virtual call and no pointer
 // chase per ray). A new kind of primitive gets its array here, its Kind and case in the BVH's

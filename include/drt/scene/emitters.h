@@ -50,6 +50,10 @@ class Emitters {
             double longest_edge2 = 0;     // the square of its longest edge's length
         };
         std::vector<Triangle> triangles;
+        // For one part of a shared mesh (MeshShape::part): each mesh triangle's index into
+        // `triangles`, kNotEmitting for another part's; empty when `triangles` is the whole mesh.
+        std::vector<std::uint32_t> index_of_triangle;
+        static constexpr std::uint32_t kNotEmitting = ~std::uint32_t{0};
         double area = 0;  // a sphere's or mesh's whole surface
         const Environment* environment = nullptr;
         // What next-event estimation shares shadow rays by, in the units of a thesis light's
