@@ -21,6 +21,7 @@
 #include <string>
 
 #include "drt/util/limits.h"
+#include "drt/util/little_endian.h"
 #include "drt/util/text.h"
 
 namespace drt {
@@ -151,11 +152,6 @@ DataWindow data_window(const Imf::InputFile& in, const Fail& fail) {
     return {box, w, h};
 }
 
-std::uint32_t little_endian_u32(const Bytes& data, std::size_t at) {
-    return std::uint32_t(data[at]) | std::uint32_t(data[at + 1]) << 8 |
-           std::uint32_t(data[at + 2]) << 16 | std::uint32_t(data[at + 3]) << 24;
-}
-
 // OpenEXR makes room for an attribute's value by the size the file declares before it reads
 // the value, so a file of a few hundred bytes that declares a 2 GB string costs 2 GB and
 // seconds. Every attribute of every header must fit in the file before OpenEXR sees it. A header
@@ -176,7 +172,7 @@ void check_attribute_sizes(const Bytes& data, const Fail& fail) {
         const std::size_t type_end =
             std::find(data.begin() + name_end + 1, data.end(), 0) - data.begin();
         if (type_end + 4 >= data.size()) return;
-        const std::uint32_t size = little_endian_u32(data, type_end + 1);
+        const std::uint64_t size = read_little_endian(&data[type_end + 1], 4);
         const std::size_t value = type_end + 5;
         if (size > data.size() - value) {
             const std::string name(data.begin() + at, data.begin() + name_end);
