@@ -1054,6 +1054,12 @@ TEST(SceneLoader, TrianglesOfOneMaterialAndSurfaceAreOneObjectAndAllArePartsOfOn
         }
     }
     EXPECT_TRUE(found);
+    // A part's shape is bounded by its own triangles (what photons are aimed at), not the mesh's.
+    const Shapes red_shapes = loaded.scene.objects[1]->shapes();
+    ASSERT_EQ(red_shapes.meshes.size(), 1u);
+    const Vec3 origin = mesh(loaded.scene, 1).path().at(0);
+    expect_vec(red_shapes.meshes[0].bounds.lo + origin, 0, 0, 1);
+    expect_vec(red_shapes.meshes[0].bounds.hi + origin, 1, 1, 4);
     // A part tested alone is hit only on its own triangles: the ray along z through every
     // triangle meets the Red part first at z = 1, the Gray part at z = 0 and then z = 2.
     const Ray ray{{0.25, 0.25, -1}, {0, 0, 1}};
