@@ -15,6 +15,7 @@
 #include <string_view>
 
 #include "drt/io/exr.h"
+#include "drt/io/png_chunks.h"
 #include "drt/util/atomic_file.h"
 #include "drt/util/file_reader.h"
 #include "drt/util/limits.h"
@@ -133,6 +134,9 @@ Image decode_8bit(const Bytes& data, ImageFormat format, const fs::path& path) {
         fail(path, is_png ? "not a PNG file" : "not a BMP file");
     }
     if (!is_png && bmp_is_truncated(data)) fail(path, "truncated BMP file");
+    if (is_png) {
+        if (const auto problem = png_chunk_past_end(data)) fail(path, *problem);
+    }
     if (data.size() > static_cast<std::size_t>(INT32_MAX)) fail(path, "file too large");
     int w = 0, h = 0, channels = 0;
     // The size from the header, before stb allocates for it.

@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "drt/io/exr.h"
+#include "drt/io/png_chunks.h"
 #include "drt/util/file_reader.h"
 #include "drt/util/limits.h"
 #include "drt/util/text.h"
@@ -80,6 +81,43 @@ struct CallbackReader {
     }
 };
 
+const char* name_of(Kind kind) {
+    switch (kind) {
+        case Kind::kPng:
+            return "PNG";
+        case Kind::kJpeg:
+            return "JPEG";
+        case Kind::kBmp:
+            return "BMP";
+        case Kind::kTga:
+            return "TGA";
+        case Kind::kHdr:
+            return "Radiance HDR";
+        case Kind::kExr:
+            return "OpenEXR";
+    }
+    return "image";
+}
+
+// The most pixels one byte of a valid file can carry, from each format's densest encoding.
+std::uint64_t densest_pixels_per_byte(Kind kind) {
+    switch (kind) {
+        case Kind::kPng:
+            return 8 * 1032;  // 1-bit pixels, deflate's 1032:1 at best
+        case Kind::kJpeg:
+            return 64 * 8;  // at least one bit per 8x8 block
+        case Kind::kBmp:
+            return 8;  // stb reads only uncompressed rows: 1 bit per pixel
+        case Kind::kTga:
+            return 64;  // a run of 128 pixels takes a count and a 1-byte pixel
+        case Kind::kHdr:
+            return 16;  // a run of 127 pixels' values of one of their 4 bytes takes 2 bytes
+        case Kind::kExr:
+            break;  // read by OpenEXR, never by stb
+    }
+    return 0;
+}
+
 using StbPixels = std::unique_ptr<void, decltype(&stbi_image_free)>;
 
 // Linear value of every 8-bit code under the sRGB curve, or code / 255 for data.
@@ -110,6 +148,7 @@ Image decode_stb(const Bytes& data, const fs::path& path, Kind kind, TextureEnco
                    std::uint64_t{data[i + 2]} << 8 | data[i + 3];
         };
         check_size(u32(16), u32(20));
+        if (const auto problem = png_chunk_past_end(data)) fail(path, *problem);
     }
     int w = 0, h = 0, channels = 0;
     if (!stbi_info_from_memory(data.data(), size, &w, &h, &channels) || w <= 0 || h <= 0) {
@@ -118,6 +157,16 @@ Image decode_stb(const Bytes& data, const fs::path& path, Kind kind, TextureEnco
     }
     // The size from the header alone, before stb allocates for it.
     check_size(static_cast<std::uint64_t>(w), static_cast<std::uint64_t>(h));
+    // stb decodes a file that ends early to the image's last pixel, reading zeros past the end:
+    // a 69-byte Radiance file claiming 40000x3000 pixels took 8 s to refuse, and a 664-byte
+    // JPEG claiming 65535x2048 decoded as grey. A header that promises more pixels than the
+    // format's densest encoding fits in the file is refused before any decoding.
+    if (static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h) >
+        densest_pixels_per_byte(kind) * data.size()) {
+        fail(path, std::string(name_of(kind)) + " image of " + std::to_string(w) + "x" +
+                       std::to_string(h) + " pixels cannot fit in " + std::to_string(data.size()) +
+                       " bytes: the file is truncated or corrupt");
+    }
     CallbackReader reader{data};
     const stbi_io_callbacks callbacks{&CallbackReader::read, &CallbackReader::skip,
                                       &CallbackReader::eof};

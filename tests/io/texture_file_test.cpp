@@ -146,6 +146,61 @@ TEST(TextureFile, HostileSizeIsRefusedFromTheHeader) {
     EXPECT_NE(error_of(tga).find("exceeds the limit"), std::string::npos) << error_of(tga);
 }
 
+// stb decodes a short file to the last pixel its header promises, reading zeros: a header that
+// promises more pixels than the format can pack into the file is refused before decoding, with
+// the numbers. 4096 x 4096 is within the pixel limit.
+TEST(TextureFile, APromiseOfMorePixelsThanTheFileCanHoldIsRefused) {
+    const auto be16 = [](Bytes& b, std::size_t at, unsigned v) {
+        b[at] = static_cast<unsigned char>(v >> 8), b[at + 1] = static_cast<unsigned char>(v);
+    };
+    const auto le16 = [](Bytes& b, std::size_t at, unsigned v) {
+        b[at] = static_cast<unsigned char>(v), b[at + 1] = static_cast<unsigned char>(v >> 8);
+    };
+    const auto message = [](const std::string& format, const Bytes& file) {
+        return "t.img: " + format + " image of 4096x4096 pixels cannot fit in " +
+               std::to_string(file.size()) + " bytes: the file is truncated or corrupt";
+    };
+    Bytes png = encoded("png", 1, 2, 3);
+    be16(png, 18, 4096), be16(png, 22, 4096);  // IHDR's big-endian width and height
+    EXPECT_EQ(error_of(png), message("PNG", png));
+    Bytes bmp = encoded("bmp", 1, 2, 3);
+    le16(bmp, 18, 4096), le16(bmp, 22, 4096);
+    EXPECT_EQ(error_of(bmp), message("BMP", bmp));
+    Bytes tga = encoded("tga", 1, 2, 3);
+    le16(tga, 12, 4096), le16(tga, 14, 4096);
+    EXPECT_EQ(error_of(tga), message("TGA", tga));
+    Bytes jpg = encoded("jpg", 1, 2, 3);
+    const std::size_t sof = std::string(jpg.begin(), jpg.end()).find("\xff\xc0");
+    ASSERT_NE(sof, std::string::npos);
+    be16(jpg, sof + 5, 4096), be16(jpg, sof + 7, 4096);
+    EXPECT_EQ(error_of(jpg), message("JPEG", jpg));
+    const float rgb[6] = {1, 1, 1, 1, 1, 1};
+    Bytes hdr;
+    stbi_write_hdr_to_func(append, &hdr, 2, 1, 3, rgb);
+    std::string text(hdr.begin(), hdr.end());
+    text.replace(text.find("-Y 1 +X 2"), 9, "-Y 4096 +X 4096");
+    hdr.assign(text.begin(), text.end());
+    EXPECT_EQ(error_of(hdr), message("Radiance HDR", hdr));
+}
+
+// The bound is each format's densest encoding, which real files approach only for flat colour:
+// flat images as stb writes them still load (a run-length TGA packs 32 pixels into a byte, a
+// JPEG about 60, a Radiance file 13, against bounds of 64, 512 and 16).
+TEST(TextureFile, FlatColourFilesAreWithinTheDensityBound) {
+    constexpr int w = 512, h = 256;
+    const std::vector<unsigned char> grey(3 * w * h, 128);
+    const std::vector<float> flat(3 * w * h, 0.5f);
+    for (const std::string kind : {"png", "jpg", "tga-rle", "hdr"}) {
+        Bytes file;
+        stbi_write_tga_with_rle = kind == "tga-rle" ? 1 : 0;
+        if (kind == "png") stbi_write_png_to_func(append, &file, w, h, 3, grey.data(), 3 * w);
+        if (kind == "jpg") stbi_write_jpg_to_func(append, &file, w, h, 3, grey.data(), 90);
+        if (kind == "tga-rle") stbi_write_tga_to_func(append, &file, w, h, 3, grey.data());
+        if (kind == "hdr") stbi_write_hdr_to_func(append, &file, w, h, 3, flat.data());
+        EXPECT_EQ(error_of(file), "no error") << kind;
+    }
+}
+
 // Files cut short are an error, never pixels made up from missing bytes.
 TEST(TextureFile, TruncatedFilesAreErrors) {
     const unsigned char grey[3 * 64 * 64] = {};
