@@ -20,8 +20,8 @@
 #include <new>
 #include <string>
 
+#include "drt/io/exr_header.h"
 #include "drt/util/limits.h"
-#include "drt/util/little_endian.h"
 #include "drt/util/text.h"
 
 namespace drt {
@@ -152,37 +152,6 @@ DataWindow data_window(const Imf::InputFile& in, const Fail& fail) {
     return {box, w, h};
 }
 
-// OpenEXR makes room for an attribute's value by the size the file declares before it reads
-// the value, so a file of a few hundred bytes that declares a 2 GB string costs 2 GB and
-// seconds. Every attribute of every header must fit in the file before OpenEXR sees it. A header
-// cut short is left for OpenEXR to report.
-template <class Fail>
-void check_attribute_sizes(const Bytes& data, const Fail& fail) {
-    if (data.size() < 8) return;
-    const bool multipart = (data[5] & 0x10) != 0;  // version flag 0x1000
-    std::size_t at = 8;
-    while (at < data.size()) {
-        if (data[at] == 0) {  // the end of a header
-            ++at;
-            if (!multipart || at >= data.size() || data[at] == 0) return;
-            continue;
-        }
-        const std::size_t name_end = std::find(data.begin() + at, data.end(), 0) - data.begin();
-        if (name_end >= data.size()) return;
-        const std::size_t type_end =
-            std::find(data.begin() + name_end + 1, data.end(), 0) - data.begin();
-        if (type_end + 4 >= data.size()) return;
-        const std::uint64_t size = read_little_endian(&data[type_end + 1], 4);
-        const std::size_t value = type_end + 5;
-        if (size > data.size() - value) {
-            const std::string name(data.begin() + at, data.begin() + name_end);
-            throw fail("OpenEXR attribute " + printable(name) + " claims " + std::to_string(size) +
-                       " bytes, more than the file holds");
-        }
-        at = value + size;
-    }
-}
-
 }  // namespace
 
 Image decode_exr(const Bytes& data, const fs::path& path) {
@@ -191,7 +160,7 @@ Image decode_exr(const Bytes& data, const fs::path& path) {
     };
     // OpenEXR reports everything, from a bad magic number to a truncated tile, by throwing.
     try {
-        check_attribute_sizes(data, fail);
+        if (const auto problem = exr_attribute_past_end(data)) throw fail(*problem);
         MemoryIStream stream(data, path);
         // No worker threads: a pool costs a thread start per file and one worker gains nothing.
         Imf::InputFile in(stream, 0);
@@ -244,7 +213,7 @@ std::vector<float> decode_exr_channel(const Bytes& data, const std::string& name
         return ImageError(printable(path.string()) + ": " + what);
     };
     try {
-        check_attribute_sizes(data, fail);
+        if (const auto problem = exr_attribute_past_end(data)) throw fail(*problem);
         MemoryIStream stream(data, path);
         Imf::InputFile in(stream, 0);
         const DataWindow window = data_window(in, fail);
