@@ -160,7 +160,7 @@ Image decode_exr(const Bytes& data, const fs::path& path) {
     };
     // OpenEXR reports everything, from a bad magic number to a truncated tile, by throwing.
     try {
-        if (const auto problem = exr_attribute_past_end(data)) throw fail(*problem);
+        if (const auto problem = exr_header_problem(data)) throw fail(*problem);
         MemoryIStream stream(data, path);
         // No worker threads: a pool costs a thread start per file and one worker gains nothing.
         Imf::InputFile in(stream, 0);
@@ -213,7 +213,7 @@ std::vector<float> decode_exr_channel(const Bytes& data, const std::string& name
         return ImageError(printable(path.string()) + ": " + what);
     };
     try {
-        if (const auto problem = exr_attribute_past_end(data)) throw fail(*problem);
+        if (const auto problem = exr_header_problem(data)) throw fail(*problem);
         MemoryIStream stream(data, path);
         Imf::InputFile in(stream, 0);
         const DataWindow window = data_window(in, fail);

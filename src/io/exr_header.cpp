@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <string_view>
 
+#include "drt/util/limits.h"
 #include "drt/util/little_endian.h"
 #include "drt/util/text.h"
 
@@ -54,37 +55,94 @@ std::optional<std::uint64_t> fixed_size(std::string_view type) {
 // A name as OpenEXR reads it: at most 255 bytes and a terminating zero; its length, or nothing
 // where OpenEXR refuses it (or the file ends first).
 std::optional<std::size_t> name_length(std::span<const unsigned char> file, std::size_t at) {
-    const std::size_t end = std::min(file.size(), at + 256);
-    const auto zero = std::find(file.begin() + static_cast<std::ptrdiff_t>(at),
-                                file.begin() + static_cast<std::ptrdiff_t>(end), 0);
-    if (zero == file.begin() + static_cast<std::ptrdiff_t>(end)) return std::nullopt;
-    return static_cast<std::size_t>(zero - (file.begin() + static_cast<std::ptrdiff_t>(at)));
+    if (at >= file.size()) return std::nullopt;
+    const auto begin = file.begin() + static_cast<std::ptrdiff_t>(at);
+    const auto end = file.begin() + static_cast<std::ptrdiff_t>(std::min(file.size(), at + 256));
+    const auto zero = std::find(begin, end, 0);
+    if (zero == end) return std::nullopt;
+    return static_cast<std::size_t>(zero - begin);
 }
 
-// A channel list: entries of a name and 16 bytes, up to an empty name; OpenEXR reads it to its
-// end whatever size is declared. The bytes it reads, or nothing where the file ends first.
-std::optional<std::uint64_t> channel_list_size(std::span<const unsigned char> file,
-                                               std::size_t at) {
+std::int64_t signed32(std::span<const unsigned char> file, std::size_t at) {
+    return static_cast<std::int32_t>(read_little_endian(&file[at], 4));
+}
+
+// A channel list: entries of a name, a pixel type, flags and sampling (16 bytes), up to an empty
+// name; OpenEXR reads it to its end whatever size is declared.
+struct ChannelList {
+    std::uint64_t size = 0;         // the bytes OpenEXR reads
+    std::uint64_t pixel_bytes = 0;  // all channels' bytes a pixel, as if none were subsampled
+};
+
+std::optional<ChannelList> channel_list(std::span<const unsigned char> file, std::size_t at) {
+    ChannelList list;
     std::size_t p = at;
     while (true) {
         const auto length = name_length(file, p);
         if (!length) return std::nullopt;
         p += *length + 1;
-        if (*length == 0) return p - at;
+        if (*length == 0) break;
+        if (p + 16 > file.size()) return std::nullopt;
+        list.pixel_bytes += signed32(file, p) == 1 ? 2 : 4;  // half, else uint or float
         p += 16;
     }
+    list.size = p - at;
+    return list;
 }
+
+// The scan lines in one block of each compression (0 = none, 1 RLE, 2 ZIPS, 3 ZIP, 4 PIZ,
+// 5 PXR24, 6 B44, 7 B44A, 8 DWAA, 9 DWAB); OpenEXR refuses any other.
+std::uint64_t lines_per_block(int compression) {
+    static constexpr std::uint64_t kLines[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
+    return compression >= 0 && compression < 10 ? kLines[compression] : 256;
+}
+
+// What one header declares about its pixels (OpenEXR's defaults where it declares nothing).
+struct Layout {
+    std::optional<std::pair<std::int64_t, std::int64_t>> size;  // of the data window
+    std::uint64_t pixel_bytes = 0;
+    int compression = 0;
+    std::optional<std::pair<std::uint64_t, std::uint64_t>> tile;
+
+    std::optional<std::string> problem() const {
+        if (!size) return std::nullopt;
+        const auto [w, h] = *size;
+        if (w <= 0 || h <= 0) return std::nullopt;  // OpenEXR's to refuse
+        if (w > kMaxImageSide || h > kMaxImageSide ||
+            static_cast<std::uint64_t>(w * h) > kMaxPixels) {
+            return "image of " + std::to_string(w) + "x" + std::to_string(h) +
+                   " pixels exceeds the limit of " + std::to_string(kMaxPixels) + " pixels";
+        }
+        const std::uint64_t pixels =
+            tile ? tile->first * tile->second
+                 : static_cast<std::uint64_t>(w) * lines_per_block(compression);
+        // Tiles up to 2^32 a side: compare without overflowing.
+        if (pixel_bytes > 0 && pixels > kMaxExrBlockBytes / pixel_bytes) {
+            const std::string block = tile ? "a tile of " + std::to_string(tile->first) + "x" +
+                                                 std::to_string(tile->second) + " pixels"
+                                           : std::to_string(lines_per_block(compression)) +
+                                                 " lines of " + std::to_string(w) + " pixels";
+            return "OpenEXR block of " + block + " at " + std::to_string(pixel_bytes) +
+                   " bytes a pixel exceeds the limit of " + std::to_string(kMaxExrBlockBytes) +
+                   " bytes";
+        }
+        return std::nullopt;
+    }
+};
 
 }  // namespace
 
-std::optional<std::string> exr_attribute_past_end(std::span<const unsigned char> file) {
+std::optional<std::string> exr_header_problem(std::span<const unsigned char> file) {
     if (file.size() < 8) return std::nullopt;
     const bool multipart = (file[5] & 0x10) != 0;  // version flag 0x1000
     std::size_t at = 8;
+    Layout layout;
     while (at < file.size()) {
         const auto name = name_length(file, at);
         if (!name) return std::nullopt;
         if (*name == 0) {  // the end of a header
+            if (auto problem = layout.problem()) return problem;
+            layout = {};
             ++at;
             if (!multipart || at >= file.size() || file[at] == 0) return std::nullopt;
             continue;
@@ -94,43 +152,52 @@ std::optional<std::string> exr_attribute_past_end(std::span<const unsigned char>
         if (!type_length) return std::nullopt;
         const std::size_t size_at = type_at + *type_length + 1;
         if (size_at + 4 > file.size()) return std::nullopt;
-        const auto declared = static_cast<std::int32_t>(read_little_endian(&file[size_at], 4));
+        const std::int64_t declared = signed32(file, size_at);
         if (declared < 0) return std::nullopt;
         const std::size_t value = size_at + 4;
         const std::uint64_t left = file.size() - value;
+        const std::string_view name_view(reinterpret_cast<const char*>(&file[at]), *name);
         const std::string_view type(reinterpret_cast<const char*>(&file[type_at]), *type_length);
-        const auto name_text = [&] {
-            return printable(std::string(reinterpret_cast<const char*>(&file[at]), *name));
+        const auto claims = [&](const std::string& what) {
+            return "OpenEXR attribute " + printable(name_view) + " claims " + what +
+                   ", more than the file holds";
         };
 
         // What OpenEXR reserves for the value, and how far it reads.
         std::uint64_t reserved = 0, read = static_cast<std::uint64_t>(declared);
         if (const auto fixed = fixed_size(type)) {
             read = *fixed;
+            if (left < read) return std::nullopt;  // OpenEXR's to refuse
+            if (name_view == "dataWindow" && type == "box2i") {
+                layout.size = {signed32(file, value + 8) - signed32(file, value) + 1,
+                               signed32(file, value + 12) - signed32(file, value + 4) + 1};
+            } else if (name_view == "compression" && type == "compression") {
+                layout.compression = file[value];
+            } else if (name_view == "tiles" && type == "tiledesc") {
+                layout.tile = {read_little_endian(&file[value], 4),
+                               read_little_endian(&file[value + 4], 4)};
+            }
         } else if (type == "chlist") {
-            const auto size = channel_list_size(file, value);
-            if (!size) return std::nullopt;
-            read = *size;
+            const auto list = channel_list(file, value);
+            if (!list) return std::nullopt;
+            read = list->size;
+            if (name_view == "channels") layout.pixel_bytes = list->pixel_bytes;
         } else if (type == "preview") {  // width and height, then 4 bytes a pixel
             if (left < 8) return std::nullopt;
             const std::uint64_t w = read_little_endian(&file[value], 4);
             const std::uint64_t h = read_little_endian(&file[value + 4], 4);
             if (w * h > (left - 8) / 4) {
-                return "OpenEXR attribute " + name_text() + " claims a preview of " +
-                       std::to_string(w) + "x" + std::to_string(h) +
-                       " pixels, more than the file holds";
+                return claims("a preview of " + std::to_string(w) + "x" + std::to_string(h) +
+                              " pixels");
             }
             reserved = 4 * w * h;
             read = 8 + reserved;
         } else if (type == "floatvector") {
-            reserved = read = declared / 4 * 4;
+            reserved = read = read / 4 * 4;
         } else {  // string, stringvector, idmanifest and any type OpenEXR does not know
             reserved = read;
         }
-        if (reserved > left) {
-            return "OpenEXR attribute " + name_text() + " claims " + std::to_string(reserved) +
-                   " bytes, more than the file holds";
-        }
+        if (reserved > left) return claims(std::to_string(reserved) + " bytes");
         at = value + read;
     }
     return std::nullopt;

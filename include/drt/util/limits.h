@@ -61,6 +61,11 @@ inline constexpr std::uint64_t kMaxObjBytes = std::uint64_t{1} << 30;
 // An image file larger than this is refused while reading: a .pfm of kMaxPixels with its header.
 inline constexpr std::uint64_t kMaxImageFileBytes = 12 * kMaxPixels + 4096;
 
+// One block of an OpenEXR file as its reader holds it decoded (a block of scan lines, or a tile),
+// all channels: the reader allocates it from the header, twice, before it reads any pixel. A
+// 65536-pixel row of eight float channels in DWAB's 256-line blocks still fits.
+inline constexpr std::uint64_t kMaxExrBlockBytes = std::uint64_t{512} << 20;  // 512 MiB
+
 // The image textures of a scene together, their mip-maps included: half the budget, leaving the
 // rest to the rendered image, the meshes and the renderer's own memory.
 inline constexpr std::uint64_t kMaxTextureBytes = kMemoryBudget / 2;
