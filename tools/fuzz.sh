@@ -46,9 +46,15 @@ fi
 "$binary" "$corpus" ${dict:+-dict="$dict"} -max_total_time="$seconds" -rss_limit_mb=4096 \
     -timeout=30 -print_final_stats=1 -artifact_prefix="$root/build-fuzz/crash-$target-" 2>&1 |
     grep -E "^(#[0-9]+ *DONE|Done|stat::number_of_executed_units|stat::new_units_added)|ERROR|SUMMARY|Test unit written|crash-|timeout-|oom-|leak-|slow-unit" || true
-# libFuzzer's own exit status is lost in the pipe; an artefact is the verdict.
-if compgen -G "build-fuzz/crash-$target-*" >/dev/null; then
-    echo "fuzz.sh: $target found a failure: $(ls build-fuzz/crash-"$target"-*)" >&2
+# libFuzzer's own exit status is lost in the pipe; an artefact is the verdict. A slow unit (over
+# 10 s) is named but does not fail the run: under a loaded sanitizer build one input's time varies
+# several-fold, so only a timeout (30 s) fails; long hunts find slow inputs (docs/testing.md).
+if compgen -G "build-fuzz/crash-$target-slow-unit-*" >/dev/null; then
+    echo "fuzz.sh: $target: slow input kept: $(ls build-fuzz/crash-"$target"-slow-unit-*)" >&2
+fi
+failures=$(compgen -G "build-fuzz/crash-$target-*" | grep -v -- "-slow-unit-" || true)
+if [ -n "$failures" ]; then
+    echo "fuzz.sh: $target found a failure: $failures" >&2
     exit 1
 fi
 echo "fuzz.sh: $target: no failure in ${seconds} s"
