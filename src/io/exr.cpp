@@ -146,8 +146,7 @@ DataWindow data_window(const Imf::InputFile& in, const Fail& fail) {
     const long long h = static_cast<long long>(box.max.y) - box.min.y + 1;
     if (w <= 0 || h <= 0) throw fail("bad OpenEXR data window");
     if (w > kMaxImageSide || h > kMaxImageSide || static_cast<std::uint64_t>(w * h) > kMaxPixels) {
-        throw fail("image of " + std::to_string(w) + "x" + std::to_string(h) +
-                   " pixels exceeds the limit of " + std::to_string(kMaxPixels) + " pixels");
+        throw fail(too_many_pixels(w, h));
     }
     return {box, w, h};
 }

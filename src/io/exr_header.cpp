@@ -4,8 +4,8 @@
 #include <cstdint>
 #include <string_view>
 
+#include "drt/util/byte_order.h"
 #include "drt/util/limits.h"
-#include "drt/util/little_endian.h"
 #include "drt/util/text.h"
 
 namespace drt {
@@ -110,8 +110,7 @@ struct Layout {
         if (w <= 0 || h <= 0) return std::nullopt;  // OpenEXR's to refuse
         if (w > kMaxImageSide || h > kMaxImageSide ||
             static_cast<std::uint64_t>(w * h) > kMaxPixels) {
-            return "image of " + std::to_string(w) + "x" + std::to_string(h) +
-                   " pixels exceeds the limit of " + std::to_string(kMaxPixels) + " pixels";
+            return too_many_pixels(w, h);
         }
         const std::uint64_t pixels =
             tile ? tile->first * tile->second

@@ -17,9 +17,9 @@
 #include "drt/io/exr.h"
 #include "drt/io/png_chunks.h"
 #include "drt/util/atomic_file.h"
+#include "drt/util/byte_order.h"
 #include "drt/util/file_reader.h"
 #include "drt/util/limits.h"
-#include "drt/util/little_endian.h"
 #include "drt/util/text.h"
 
 namespace drt {
@@ -35,11 +35,6 @@ constexpr int kMaxSide = 1 << 24;
 
 [[noreturn]] void fail(const fs::path& path, const std::string& what) {
     throw ImageError(printable(path.string()) + ": " + what);
-}
-
-std::string too_many_pixels(int w, int h) {
-    return "image of " + std::to_string(w) + "x" + std::to_string(h) +
-           " pixels exceeds the limit of " + std::to_string(kMaxPixels) + " pixels";
 }
 
 // ---- encoding -------------------------------------------------------------------------------

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 
+#include "drt/util/byte_order.h"
 #include "drt/util/text.h"
 
 namespace drt {
@@ -10,9 +11,7 @@ std::optional<std::string> png_chunk_past_end(std::span<const unsigned char> fil
     // Each chunk: a big-endian length, a 4-letter type, the data, a CRC.
     std::size_t at = 8;
     while (at + 8 <= file.size()) {
-        const std::uint64_t length = std::uint64_t{file[at]} << 24 |
-                                     std::uint64_t{file[at + 1]} << 16 |
-                                     std::uint64_t{file[at + 2]} << 8 | file[at + 3];
+        const std::uint64_t length = read_big_endian(file.data() + at, 4);
         const std::string type(reinterpret_cast<const char*>(file.data() + at + 4), 4);
         if (length > file.size() - (at + 8)) {
             return "PNG chunk " + printable(type) + " claims " + std::to_string(length) +

@@ -12,6 +12,7 @@
 
 #include "drt/io/exr.h"
 #include "drt/io/png_chunks.h"
+#include "drt/util/byte_order.h"
 #include "drt/util/file_reader.h"
 #include "drt/util/limits.h"
 #include "drt/util/text.h"
@@ -136,18 +137,12 @@ Image decode_stb(const Bytes& data, const fs::path& path, Kind kind, TextureEnco
     const int size = static_cast<int>(data.size());
     const auto check_size = [&](std::uint64_t w, std::uint64_t h) {
         if (w > kMaxImageSide || h > kMaxImageSide || w * h > kMaxPixels) {
-            fail(path, "image of " + std::to_string(w) + "x" + std::to_string(h) +
-                           " pixels exceeds the limit of " + std::to_string(kMaxPixels) +
-                           " pixels");
+            fail(path, too_many_pixels(w, h));
         }
     };
     // stb refuses a huge PNG from its header too, but says only "too large": read the size.
     if (kind == Kind::kPng && data.size() >= 24) {
-        const auto u32 = [&](std::size_t i) {
-            return std::uint64_t{data[i]} << 24 | std::uint64_t{data[i + 1]} << 16 |
-                   std::uint64_t{data[i + 2]} << 8 | data[i + 3];
-        };
-        check_size(u32(16), u32(20));
+        check_size(read_big_endian(data.data() + 16, 4), read_big_endian(data.data() + 20, 4));
         if (const auto problem = png_chunk_past_end(data)) fail(path, *problem);
     }
     int w = 0, h = 0, channels = 0;

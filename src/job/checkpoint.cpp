@@ -8,9 +8,9 @@
 
 #include "drt/job/tile_codec.h"
 #include "drt/util/atomic_file.h"
+#include "drt/util/byte_order.h"
 #include "drt/util/file_reader.h"
 #include "drt/util/limits.h"
-#include "drt/util/little_endian.h"
 #include "drt/util/rng.h"
 #include "drt/util/text.h"
 

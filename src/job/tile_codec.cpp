@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <stdexcept>
 
-#include "drt/util/little_endian.h"
+#include "drt/util/byte_order.h"
 
 namespace drt {
 

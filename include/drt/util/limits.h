@@ -25,6 +25,9 @@ inline constexpr std::uint64_t kBytesPerSample = 576;
 // 2^27 pixels (e.g. 16384 x 8192) take 3.5 GiB at 28 bytes each: the largest power of two
 // within the budget.
 inline constexpr std::uint64_t kMaxPixels = std::uint64_t{1} << 27;
+// What every reader of an image's size says when it is past a limit: "image of WxH pixels
+// exceeds the limit of 134217728 pixels".
+std::string too_many_pixels(std::uint64_t width, std::uint64_t height);
 // Either side; a 65536 x 2048 image is still within kMaxPixels.
 inline constexpr int kMaxImageSide = 65536;
 // Camera samples per pixel, and shadow or glossy rays per shading point: 2^16 each, so that a
