@@ -183,6 +183,63 @@ TEST(TextureFile, APromiseOfMorePixelsThanTheFileCanHoldIsRefused) {
     EXPECT_EQ(error_of(hdr), message("Radiance HDR", hdr));
 }
 
+// Each format's bound exactly: a header promising bound x size pixels (width the bound, height
+// the file's size in bytes) passes the check, one more column does not. A 2 % change of any
+// bound fails here. What stb then makes of the file (zeros or an error) is not this test's.
+TEST(TextureFile, TheDensityBoundOfEachFormatHoldsExactly) {
+    const auto be16 = [](Bytes& b, std::size_t at, std::uint64_t v) {
+        b[at] = static_cast<unsigned char>(v >> 8), b[at + 1] = static_cast<unsigned char>(v);
+    };
+    const auto le16 = [](Bytes& b, std::size_t at, std::uint64_t v) {
+        b[at] = static_cast<unsigned char>(v), b[at + 1] = static_cast<unsigned char>(v >> 8);
+    };
+    const auto refused = [](const Bytes& file) {
+        return error_of(file).find("cannot fit in") != std::string::npos;
+    };
+    struct Format {
+        std::string kind;
+        std::uint64_t bound;  // pixels a byte
+    };
+    for (const Format& f :
+         {Format{"png", 8256}, Format{"jpg", 512}, Format{"bmp", 8}, Format{"tga", 64}}) {
+        Bytes file = encoded(f.kind, 1, 2, 3);
+        const std::uint64_t h = file.size();
+        const auto promise = [&](std::uint64_t w) {
+            if (f.kind == "png") be16(file, 18, w), be16(file, 22, h);
+            if (f.kind == "bmp") le16(file, 18, w), le16(file, 22, h);
+            if (f.kind == "tga") le16(file, 12, w), le16(file, 14, h);
+            if (f.kind == "jpg") {
+                const std::size_t sof = std::string(file.begin(), file.end()).find("\xff\xc0");
+                ASSERT_NE(sof, std::string::npos);
+                be16(file, sof + 5, h), be16(file, sof + 7, w);
+            }
+        };
+        promise(f.bound);
+        EXPECT_FALSE(refused(file)) << f.kind << ": " << error_of(file);
+        promise(f.bound + 1);
+        EXPECT_TRUE(refused(file)) << f.kind << ": " << error_of(file);
+    }
+    // A Radiance header is text, whose length changes with the digits written: the height is
+    // found as the size of the file it ends up in.
+    const float rgb[6] = {1, 1, 1, 1, 1, 1};
+    Bytes two_pixels;
+    stbi_write_hdr_to_func(append, &two_pixels, 2, 1, 3, rgb);
+    const auto hdr_promising = [&](std::uint64_t w) {
+        const std::string text(two_pixels.begin(), two_pixels.end());
+        const std::string dims = "-Y 1 +X 2";
+        std::string file;
+        for (std::uint64_t h = text.size();; h = file.size()) {
+            file = text;
+            file.replace(file.find(dims), dims.size(),
+                         "-Y " + std::to_string(h) + " +X " + std::to_string(w));
+            if (file.size() == h) break;
+        }
+        return Bytes(file.begin(), file.end());
+    };
+    EXPECT_FALSE(refused(hdr_promising(16))) << error_of(hdr_promising(16));
+    EXPECT_TRUE(refused(hdr_promising(17))) << error_of(hdr_promising(17));
+}
+
 // The bound is each format's densest encoding, which real files approach only for flat colour:
 // flat images as stb writes them still load (a run-length TGA packs 32 pixels into a byte, a
 // JPEG about 60, a Radiance file 13, against bounds of 64, 512 and 16).
