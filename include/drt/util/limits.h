@@ -25,11 +25,16 @@ inline constexpr std::uint64_t kBytesPerSample = 576;
 // 2^27 pixels (e.g. 16384 x 8192) take 3.5 GiB at 28 bytes each: the largest power of two
 // within the budget.
 inline constexpr std::uint64_t kMaxPixels = std::uint64_t{1} << 27;
+// Either side; a 65536 x 2048 image is still within kMaxPixels.
+inline constexpr int kMaxImageSide = 65536;
+// Whether an image of width x height is past either limit above (the sides checked first, so the
+// product cannot overflow).
+constexpr bool past_image_limits(std::uint64_t width, std::uint64_t height) {
+    return width > kMaxImageSide || height > kMaxImageSide || width * height > kMaxPixels;
+}
 // What every reader of an image's size says when it is past a limit: "image of WxH pixels
 // exceeds the limit of 134217728 pixels".
 std::string too_many_pixels(std::uint64_t width, std::uint64_t height);
-// Either side; a 65536 x 2048 image is still within kMaxPixels.
-inline constexpr int kMaxImageSide = 65536;
 // Camera samples per pixel, and shadow or glossy rays per shading point: 2^16 each, so that a
 // pixel's sample index times a set's size stays within the samplers' 32-bit index space (and a
 // thread's per-sample memory within 36 MiB).
