@@ -37,6 +37,36 @@ Bytes encoded(const std::string& kind, unsigned char a, unsigned char b, unsigne
     return out;
 }
 
+// `file`, as `encoded` wrote it in the format `kind`, with its header promising w x h pixels.
+void promise_size(Bytes& file, const std::string& kind, std::uint64_t w, std::uint64_t h) {
+    const auto be16 = [&](std::size_t at, std::uint64_t v) {
+        file.at(at) = static_cast<unsigned char>(v >> 8);
+        file.at(at + 1) = static_cast<unsigned char>(v);
+    };
+    const auto le16 = [&](std::size_t at, std::uint64_t v) {
+        file.at(at) = static_cast<unsigned char>(v);
+        file.at(at + 1) = static_cast<unsigned char>(v >> 8);
+    };
+    if (kind == "png") be16(18, w), be16(22, h);  // IHDR's big-endian width and height
+    if (kind == "bmp") le16(18, w), le16(22, h);
+    if (kind == "tga") le16(12, w), le16(14, h);
+    if (kind == "jpg") {
+        const std::size_t sof = std::string(file.begin(), file.end()).find("\xff\xc0");
+        ASSERT_NE(sof, std::string::npos);
+        be16(sof + 5, h), be16(sof + 7, w);
+    }
+}
+
+// A Radiance file of two white pixels whose header's size line reads `size` instead.
+Bytes radiance_file(const std::string& size) {
+    const float rgb[6] = {1, 1, 1, 1, 1, 1};
+    Bytes two_pixels;
+    stbi_write_hdr_to_func(append, &two_pixels, 2, 1, 3, rgb);
+    std::string text(two_pixels.begin(), two_pixels.end());
+    text.replace(text.find("-Y 1 +X 2"), 9, size);
+    return Bytes(text.begin(), text.end());
+}
+
 Image decode(const Bytes& data, TextureEncoding encoding = TextureEncoding::kColor) {
     return decode_texture(data, "t.img", encoding);
 }
@@ -150,36 +180,19 @@ TEST(TextureFile, HostileSizeIsRefusedFromTheHeader) {
 // promises more pixels than the format can pack into the file is refused before decoding, with
 // the numbers. 4096 x 4096 is within the pixel limit.
 TEST(TextureFile, APromiseOfMorePixelsThanTheFileCanHoldIsRefused) {
-    const auto be16 = [](Bytes& b, std::size_t at, unsigned v) {
-        b[at] = static_cast<unsigned char>(v >> 8), b[at + 1] = static_cast<unsigned char>(v);
-    };
-    const auto le16 = [](Bytes& b, std::size_t at, unsigned v) {
-        b[at] = static_cast<unsigned char>(v), b[at + 1] = static_cast<unsigned char>(v >> 8);
-    };
     const auto message = [](const std::string& format, const Bytes& file) {
         return "t.img: " + format + " image of 4096x4096 pixels cannot fit in " +
                std::to_string(file.size()) + " bytes: the file is truncated or corrupt";
     };
-    Bytes png = encoded("png", 1, 2, 3);
-    be16(png, 18, 4096), be16(png, 22, 4096);  // IHDR's big-endian width and height
-    EXPECT_EQ(error_of(png), message("PNG", png));
-    Bytes bmp = encoded("bmp", 1, 2, 3);
-    le16(bmp, 18, 4096), le16(bmp, 22, 4096);
-    EXPECT_EQ(error_of(bmp), message("BMP", bmp));
-    Bytes tga = encoded("tga", 1, 2, 3);
-    le16(tga, 12, 4096), le16(tga, 14, 4096);
-    EXPECT_EQ(error_of(tga), message("TGA", tga));
-    Bytes jpg = encoded("jpg", 1, 2, 3);
-    const std::size_t sof = std::string(jpg.begin(), jpg.end()).find("\xff\xc0");
-    ASSERT_NE(sof, std::string::npos);
-    be16(jpg, sof + 5, 4096), be16(jpg, sof + 7, 4096);
-    EXPECT_EQ(error_of(jpg), message("JPEG", jpg));
-    const float rgb[6] = {1, 1, 1, 1, 1, 1};
-    Bytes hdr;
-    stbi_write_hdr_to_func(append, &hdr, 2, 1, 3, rgb);
-    std::string text(hdr.begin(), hdr.end());
-    text.replace(text.find("-Y 1 +X 2"), 9, "-Y 4096 +X 4096");
-    hdr.assign(text.begin(), text.end());
+    for (const auto& [kind, format] : {std::pair<std::string, std::string>{"png", "PNG"},
+                                       {"bmp", "BMP"},
+                                       {"tga", "TGA"},
+                                       {"jpg", "JPEG"}}) {
+        Bytes file = encoded(kind, 1, 2, 3);
+        promise_size(file, kind, 4096, 4096);
+        EXPECT_EQ(error_of(file), message(format, file));
+    }
+    const Bytes hdr = radiance_file("-Y 4096 +X 4096");
     EXPECT_EQ(error_of(hdr), message("Radiance HDR", hdr));
 }
 
@@ -187,12 +200,6 @@ TEST(TextureFile, APromiseOfMorePixelsThanTheFileCanHoldIsRefused) {
 // the file's size in bytes) passes the check, one more column does not. A 2 % change of any
 // bound fails here. What stb then makes of the file (zeros or an error) is not this test's.
 TEST(TextureFile, TheDensityBoundOfEachFormatHoldsExactly) {
-    const auto be16 = [](Bytes& b, std::size_t at, std::uint64_t v) {
-        b[at] = static_cast<unsigned char>(v >> 8), b[at + 1] = static_cast<unsigned char>(v);
-    };
-    const auto le16 = [](Bytes& b, std::size_t at, std::uint64_t v) {
-        b[at] = static_cast<unsigned char>(v), b[at + 1] = static_cast<unsigned char>(v >> 8);
-    };
     const auto refused = [](const Bytes& file) {
         return error_of(file).find("cannot fit in") != std::string::npos;
     };
@@ -203,38 +210,20 @@ TEST(TextureFile, TheDensityBoundOfEachFormatHoldsExactly) {
     for (const Format& f :
          {Format{"png", 8256}, Format{"jpg", 512}, Format{"bmp", 8}, Format{"tga", 64}}) {
         Bytes file = encoded(f.kind, 1, 2, 3);
-        const std::uint64_t h = file.size();
-        const auto promise = [&](std::uint64_t w) {
-            if (f.kind == "png") be16(file, 18, w), be16(file, 22, h);
-            if (f.kind == "bmp") le16(file, 18, w), le16(file, 22, h);
-            if (f.kind == "tga") le16(file, 12, w), le16(file, 14, h);
-            if (f.kind == "jpg") {
-                const std::size_t sof = std::string(file.begin(), file.end()).find("\xff\xc0");
-                ASSERT_NE(sof, std::string::npos);
-                be16(file, sof + 5, h), be16(file, sof + 7, w);
-            }
-        };
-        promise(f.bound);
+        promise_size(file, f.kind, f.bound, file.size());
         EXPECT_FALSE(refused(file)) << f.kind << ": " << error_of(file);
-        promise(f.bound + 1);
+        promise_size(file, f.kind, f.bound + 1, file.size());
         EXPECT_TRUE(refused(file)) << f.kind << ": " << error_of(file);
     }
     // A Radiance header is text, whose length changes with the digits written: the height is
     // found as the size of the file it ends up in.
-    const float rgb[6] = {1, 1, 1, 1, 1, 1};
-    Bytes two_pixels;
-    stbi_write_hdr_to_func(append, &two_pixels, 2, 1, 3, rgb);
-    const auto hdr_promising = [&](std::uint64_t w) {
-        const std::string text(two_pixels.begin(), two_pixels.end());
-        const std::string dims = "-Y 1 +X 2";
-        std::string file;
-        for (std::uint64_t h = text.size();; h = file.size()) {
-            file = text;
-            file.replace(file.find(dims), dims.size(),
-                         "-Y " + std::to_string(h) + " +X " + std::to_string(w));
-            if (file.size() == h) break;
-        }
-        return Bytes(file.begin(), file.end());
+    const auto hdr_promising = [](std::uint64_t w) {
+        const auto promising = [w](std::uint64_t h) {
+            return radiance_file("-Y " + std::to_string(h) + " +X " + std::to_string(w));
+        };
+        std::uint64_t h = 1;
+        while (promising(h).size() != h) h = promising(h).size();
+        return promising(h);
     };
     EXPECT_FALSE(refused(hdr_promising(16))) << error_of(hdr_promising(16));
     EXPECT_TRUE(refused(hdr_promising(17))) << error_of(hdr_promising(17));

@@ -9,7 +9,7 @@ namespace drt {
 namespace {
 
 TEST(ByteOrder, AChunkLengthReadsHighestByteFirst) {
-    // IHDR's length as every PNG stores it, and a length with all four bytes set.
+    // IHDR's length as every PNG stores it, and bytes whose two orders read differently.
     const unsigned char ihdr[] = {0x00, 0x00, 0x00, 0x0d};
     EXPECT_EQ(read_big_endian(ihdr, 4), 13u);
     const unsigned char mixed[] = {0x52, 0x00, 0x00, 0x18};
