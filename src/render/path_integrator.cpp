@@ -187,7 +187,12 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
             result += throughput * diffuse_colour * light;
         }
 
-        const double pick = sampler_.get_1d(s, path_dim::at(depth, path_dim::kLobe)) * total;
+        // A material of one part (most are) needs no pick: 0 lands in that part as any u would,
+        // and a sample not drawn changes no other, since each is a function of its dimension.
+        const bool one_part =
+            (diffuse_weight > 0) + (reflect_weight > 0) + (transmit_weight > 0) == 1;
+        const double pick =
+            one_part ? 0.0 : sampler_.get_1d(s, path_dim::at(depth, path_dim::kLobe)) * total;
         const std::uint32_t scatter_dimension = path_dim::at(depth, path_dim::kScatter);
         Vec3 dir;
         if (pick < diffuse_weight) {

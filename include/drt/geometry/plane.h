@@ -23,6 +23,10 @@ inline std::optional<double> intersect_plane(const Vec3& point, const Vec3& norm
     const double on_plane_tolerance =
         8.0 * std::numeric_limits<double>::epsilon() * (origin_scale + point_scale);
     if (std::abs(distance) <= on_plane_tolerance) distance = 0;
+    // A plane behind the ray (or NaN) gives t <= 0, which a range from 0 up excludes: decided by
+    // the signs, without the division, for the half of a room's walls a ray moves away from.
+    const bool ahead = distance > 0 ? denom > 0 : distance < 0 && denom < 0;
+    if (!ahead && range.min >= 0) return std::nullopt;
     const double t = distance / denom;
     if (!range.surrounds(t)) return std::nullopt;
     return t;
