@@ -163,6 +163,35 @@ std::uint32_t sub_column_key(std::uint32_t key) {
     return key * 0x02e5be93u;
 }
 
+// permute(first + i, n, key) into out[i]. Every label takes a step, and then those still outside
+// [0, n) another, pass after pass over all of them (the others left as they are) until none is:
+// the same walks as permute's, in loops that vectorise, where a walk per label would mispredict
+// its end about once per label.
+DRT_VECTORISED void permute_run(std::uint32_t first, std::uint32_t n, std::uint32_t key,
+                                std::uint32_t* out, std::size_t count) {
+    if (n <= 1) {
+        std::fill_n(out, count, 0u);
+        return;
+    }
+    const std::uint32_t w = permute_mask(n);
+    std::uint32_t walking = 0;  // an integer: a bool's |= keeps the loop from vectorising
+    for (std::size_t i = 0; i < count; ++i) {
+        const std::uint32_t x = permute_step(first + static_cast<std::uint32_t>(i), w, key);
+        out[i] = x;
+        walking |= static_cast<std::uint32_t>(x >= n);
+    }
+    while (walking != 0) {
+        walking = 0;
+        for (std::size_t i = 0; i < count; ++i) {
+            const std::uint32_t stepped = permute_step(out[i], w, key);
+            const std::uint32_t x = out[i] >= n ? stepped : out[i];
+            out[i] = x;
+            walking |= static_cast<std::uint32_t>(x >= n);
+        }
+    }
+    for (std::size_t i = 0; i < count; ++i) out[i] = permute_rotate(out[i], n, key);
+}
+
 // The grid of a pattern of k points keyed by `key`, its shuffled columns and sub-columns, the
 // jitters' key and a set's rotation: what every point of the pattern shares. A side of at most
 // five elements picks from the list of all orders; others are dealt by Fisher-Yates from as few
@@ -209,12 +238,8 @@ class Grid {
                 shuffle(column, digits);
                 shuffle(sub_column, digits);
             } else {
-                for (std::uint32_t c = 0; c < shape.m; ++c) {
-                    column[c] = permute(c, shape.m, column_key(key));
-                }
-                for (std::uint32_t r = 0; r < shape.n; ++r) {
-                    sub_column[r] = permute(r, shape.n, sub_column_key(key));
-                }
+                permute_run(0, shape.m, column_key(key), column.data(), shape.m);
+                permute_run(0, shape.n, sub_column_key(key), sub_column.data(), shape.n);
             }
         }
         rotation = k <= 4096 ? digits.below(k) : static_cast<std::uint32_t>(((h >> 32) * k) >> 32);
@@ -310,35 +335,6 @@ DRT_VECTORISED void packed_rotated_points(const Jitter& jitter, const PackedSide
     }
 }
 
-// permute(first + i, n, key) into out[i]. Every label takes a step, and then those still outside
-// [0, n) another, pass after pass over all of them (the others left as they are) until none is:
-// the same walks as permute's, in loops that vectorise, where a walk per label would mispredict
-// its end about once per label.
-DRT_VECTORISED void permute_run(std::uint32_t first, std::uint32_t n, std::uint32_t key,
-                                std::uint32_t* out, std::size_t count) {
-    if (n <= 1) {
-        std::fill_n(out, count, 0u);
-        return;
-    }
-    const std::uint32_t w = permute_mask(n);
-    std::uint32_t walking = 0;  // an integer: a bool's |= keeps the loop from vectorising
-    for (std::size_t i = 0; i < count; ++i) {
-        const std::uint32_t x = permute_step(first + static_cast<std::uint32_t>(i), w, key);
-        out[i] = x;
-        walking |= static_cast<std::uint32_t>(x >= n);
-    }
-    while (walking != 0) {
-        walking = 0;
-        for (std::size_t i = 0; i < count; ++i) {
-            const std::uint32_t stepped = permute_step(out[i], w, key);
-            const std::uint32_t x = out[i] >= n ? stepped : out[i];
-            out[i] = x;
-            walking |= static_cast<std::uint32_t>(x >= n);
-        }
-    }
-    for (std::size_t i = 0; i < count; ++i) out[i] = permute_rotate(out[i], n, key);
-}
-
 // The sides of the grids of single points (multi_jittered(j, k, key)) this thread drew lately,
 // by key. A pixel's camera samples are drawn one at a time, and every sample along the same
 // branch asks for the same dimensions, so drawing a grid's sides once per pixel and dimension
@@ -400,12 +396,8 @@ class RememberedGrids {
             sides.shape = shape;
             sides.jitter_key = jitter_key_of(grid_hash(key));
             sides.sides.resize(shape.m + shape.n);
-            for (std::uint32_t c = 0; c < shape.m; ++c) {
-                sides.sides[c] = permute(c, shape.m, column_key(key));
-            }
-            for (std::uint32_t r = 0; r < shape.n; ++r) {
-                sides.sides[shape.m + r] = permute(r, shape.n, sub_column_key(key));
-            }
+            permute_run(0, shape.m, column_key(key), sides.sides.data(), shape.m);
+            permute_run(0, shape.n, sub_column_key(key), sides.sides.data() + shape.m, shape.n);
         }
         sides.drawn = true;
     }
