@@ -107,7 +107,9 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
     if (error.available()) {
         j << "  \"estimated_rmse\": " << json_number(*error.rmse)
           << ", \"estimated_relmse\": " << json_number(*error.relmse)
-          << ", \"estimate_cost\": " << json_number(error.cost) << ",\n";
+          << ", \"estimate_cost\": " << json_number(error.cost)
+          << ", \"error_pixels\": " << json_number(error.error_pixels)
+          << ", \"rmse_scatter\": " << json_number(error.rmse_scatter()) << ",\n";
     } else {
         j << "  \"estimated_rmse\": null, \"estimated_relmse\": null, \"estimate_unavailable\": "
           << json_string(error.unavailable) << ",\n";

@@ -191,16 +191,25 @@ ErrorEstimate estimate_error(const Image& image, const Image& spread, const Erro
             e.scale = 0;  // the pixels rendered twice alike, and their samples too
         }
     }
-    double mse = 0, relmse = 0;
-    for (std::size_t i = 0; i < image.rgb.size(); ++i) {
-        const double v = e.scale * spread.rgb[i], x = image.rgb[i];
-        if (!std::isfinite(v)) {
-            e.unavailable = "a pixel took fewer than 2 samples";
-            return e;
+    // mse channel by channel; the concentration from each pixel's sum over its channels.
+    double mse = 0, relmse = 0, pixel_sum = 0, pixel_squares = 0;
+    for (std::size_t p = 0; p < image.rgb.size(); p += 3) {
+        double pixel = 0;
+        for (std::size_t i = p; i < p + 3; ++i) {
+            const double v = e.scale * spread.rgb[i], x = image.rgb[i];
+            if (!std::isfinite(v)) {
+                e.unavailable = "a pixel took fewer than 2 samples";
+                return e;
+            }
+            mse += v;
+            pixel += v;
+            relmse += v / (std::max(0.0, x * x - v) + 0.01);
         }
-        mse += v;
-        relmse += v / (std::max(0.0, x * x - v) + 0.01);
+        pixel_sum += pixel;
+        pixel_squares += pixel * pixel;
     }
+    if (pixel_squares > 0 && std::isfinite(pixel_squares))
+        e.error_pixels = pixel_sum * pixel_sum / pixel_squares;
     const double count =
         std::max(1.0, 3.0 * (pixels > 0 ? double(pixels) : double(image.width) * image.height));
     e.rmse = std::sqrt(mse / count);

@@ -1117,6 +1117,22 @@ TEST_F(CliTest, ErrorImageHoldsEachPixelsStandardErrorAndZeroForAFlatScene) {
     const std::string json = read_bytes(file("s.json"));
     EXPECT_NE(json.find("\"estimated_rmse\": 0."), std::string::npos) << json;
     EXPECT_NE(json.find("\"estimated_relmse\": "), std::string::npos) << json;
+    // How many pixels the error sits in, from the error image's variances as from the render's,
+    // and the spread of one image's true RMSE that follows.
+    double sum = 0, squares = 0;
+    for (std::size_t p = 0; p < error.rgb.size(); p += 3) {
+        const double v = double(error.rgb[p]) * error.rgb[p] +
+                         double(error.rgb[p + 1]) * error.rgb[p + 1] +
+                         double(error.rgb[p + 2]) * error.rgb[p + 2];
+        sum += v;
+        squares += v * v;
+    }
+    const Json stats = parse_json(json);
+    const double error_pixels = stats["error_pixels"].number();
+    EXPECT_NEAR(error_pixels, sum * sum / squares, 1e-4 * error_pixels);
+    EXPECT_GT(error_pixels, 1);
+    EXPECT_LT(error_pixels, 24 * 16);
+    EXPECT_NEAR(stats["rmse_scatter"].number(), 1 / std::sqrt(2 * error_pixels), 1e-5);
 
     // A scene of nothing but background: every sample alike, no error anywhere.
     write_bytes(file("flat.xml"),

@@ -346,6 +346,69 @@ TEST(EstimateError, CalibrationScalesEverySpread) {
     EXPECT_DOUBLE_EQ(e.cost, 0.1);
 }
 
+TEST(EstimateError, ErrorPixelsCountThePixelsTheErrorSitsIn) {
+    Image image(4, 1), spread(4, 1);
+    const auto error_pixels = [&] {
+        const ErrorEstimate e = estimate_error(image, spread, {}, 64, 16, SpreadKind::kIndependent);
+        EXPECT_TRUE(e.available());
+        return e;
+    };
+    // One pixel carries it all, in one channel or in three alike: a pixel's channels move
+    // together, so it is one pixel either way.
+    spread.rgb = {0, 0, 0, 0, 0.03f, 0, 0, 0, 0, 0, 0, 0};
+    EXPECT_DOUBLE_EQ(error_pixels().error_pixels, 1);
+    EXPECT_DOUBLE_EQ(error_pixels().rmse_scatter(), 1 / std::sqrt(2.0));
+    spread.rgb = {0, 0, 0, 0.01f, 0.01f, 0.01f, 0, 0, 0, 0, 0, 0};
+    EXPECT_DOUBLE_EQ(error_pixels().error_pixels, 1);
+    // Four equal pixels: four.
+    spread.rgb = {0.01f, 0.02f, 0.03f, 0.03f, 0.02f, 0.01f, 0.06f, 0, 0, 0, 0, 0.06f};
+    EXPECT_NEAR(error_pixels().error_pixels, 4, 1e-6);
+    EXPECT_NEAR(error_pixels().rmse_scatter(), 1 / std::sqrt(8.0), 1e-7);
+    // Pixels of 1 and 3 (times 0.01): (1 + 3)^2 / (1 + 9).
+    spread.rgb = {0.01f, 0, 0, 0, 0, 0, 0.01f, 0.01f, 0.01f, 0, 0, 0};
+    EXPECT_NEAR(error_pixels().error_pixels, 1.6, 1e-6);
+    // No error: nowhere.
+    spread.rgb.assign(12, 0.0f);
+    EXPECT_EQ(error_pixels().error_pixels, 0);
+    EXPECT_EQ(error_pixels().rmse_scatter(), 0);
+}
+
+// What rmse_scatter claims: images whose pixels err normally with the variances the spreads give
+// have true RMSEs that scatter about the expected one by that relative deviation, whether the
+// error sits in a few pixels or in many (a factor 2 or a square root off fails).
+TEST(EstimateError, OneImagesTrueErrorScattersByTheRmseScatter) {
+    std::mt19937_64 random(31);
+    std::normal_distribution<double> normal;
+    for (const int hot : {3, 12, 40}) {
+        Image image(100, 1), spread(100, 1);
+        for (int p = 0; p < 100; ++p) {
+            const float v = p < hot ? 1.0f : 0.002f;
+            spread.rgb[3 * p] = spread.rgb[3 * p + 1] = spread.rgb[3 * p + 2] = v;
+        }
+        const ErrorEstimate e =
+            estimate_error(image, spread, {}, 6400, 64, SpreadKind::kIndependent);
+        ASSERT_TRUE(e.available());
+        const double expected = *e.rmse;
+        constexpr int kImages = 20000;
+        double sum = 0, squares = 0;
+        for (int i = 0; i < kImages; ++i) {
+            double squared = 0;
+            for (int p = 0; p < 100; ++p) {
+                // A pixel's channels err together (an edge, a firefly), as error_pixels assumes.
+                const double err = normal(random) * std::sqrt(double(spread.rgb[3 * p]));
+                squared += 3 * err * err;
+            }
+            const double ratio = std::sqrt(squared / 300) / expected;
+            sum += ratio;
+            squares += ratio * ratio;
+        }
+        const double mean = sum / kImages;
+        const double deviation = std::sqrt(squares / kImages - mean * mean);
+        EXPECT_NEAR(deviation / mean, e.rmse_scatter(), 0.05 * e.rmse_scatter())
+            << hot << " pixels, " << e.error_pixels << " error pixels";
+    }
+}
+
 Scene small_scene(const std::string& file, const std::string& sampler, int spp,
                   std::uint64_t seed) {
     Scene scene = load_scene(std::string(DRT_SOURCE_DIR) + "/scenes/" + file).scene;

@@ -21,6 +21,7 @@
 // sums up in tile order.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -127,6 +128,18 @@ struct ErrorEstimate {
     double scale = 1;
     // The camera samples the calibration took, over the image's: its cost.
     double cost = 0;
+    // How many pixels the estimated squared error effectively sits in: (sum v)^2 / sum v^2 over
+    // the pixels, v a pixel's estimated variance summed over its channels (N for N equal pixels,
+    // about 1 when one pixel carries it all); 0 when the estimate is 0. One image's true error
+    // is a sum of that many pixels' random errors, so it scatters about the expected error
+    // however good the estimate is: by rmse_scatter(). Noise in the v, and a stratified edge's
+    // spread counting twice (strata_spread), make the count low and so the scatter high.
+    double error_pixels = 0;
+
+    // The relative standard deviation of one image's true RMSE about its expected value, for
+    // normally distributed pixel errors: the squared error of error_pixels independent pixels
+    // has a relative deviation of sqrt(2 / error_pixels), its root half that. 0 without error.
+    double rmse_scatter() const { return error_pixels > 0 ? 1 / std::sqrt(2 * error_pixels) : 0; }
 
     bool available() const { return rmse.has_value(); }
 };
