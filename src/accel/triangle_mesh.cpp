@@ -170,6 +170,7 @@ void TriangleMesh::take(const ObjMesh& obj, const MeshTransform& transform, bool
 }
 
 Vec3 TriangleMesh::geometric_normal(std::uint32_t triangle) const {
+    if (!face_normals_.empty()) return face_normals_[triangle];
     const auto [a, b, c] = corners(triangle);
     const Vec3 n = cross(b - a, c - a);
     // Scaled first: the cross product of a tiny triangle can underflow when squared.
@@ -206,7 +207,8 @@ std::size_t TriangleMesh::bytes() const {
     return positions_.capacity() * sizeof(Float3) + normals_.capacity() * sizeof(Float3) +
            triangles_.capacity() * sizeof(triangles_[0]) +
            texcoords_.capacity() * sizeof(texcoords_[0]) + corners_.capacity() * sizeof(float) +
-           parts_.capacity() * sizeof(parts_[0]) + tree_.memory() + sizeof(*this);
+           face_normals_.capacity() * sizeof(Vec3) + parts_.capacity() * sizeof(parts_[0]) +
+           tree_.memory() + sizeof(*this);
 }
 
 void TriangleMesh::build_hierarchy(int threads) {
@@ -247,6 +249,9 @@ void TriangleMesh::make_corner_arrays() {
                 corners_[static_cast<std::size_t>(3 * v + a) * stride_ + i] = positions_[t[v]][a];
         }
     }
+    std::vector<Vec3> normals(count);
+    for (std::uint32_t t = 0; t < count; ++t) normals[t] = geometric_normal(t);
+    face_normals_ = std::move(normals);
 }
 
 void TriangleMesh::order_vertices_by_leaves() {

@@ -121,7 +121,7 @@ class TriangleMesh {
     // Numbers the vertices in the order the leaves first use them, so that a leaf's corners
     // are near each other in memory.
     void order_vertices_by_leaves();
-    // corners_, for a mesh of at most kCornerArrayLimit triangles.
+    // corners_ and face_normals_, for a mesh of at most kCornerArrayLimit triangles.
     void make_corner_arrays();
     // What a query answers: whether any triangle is hit, or the nearest hit.
     template <bool kAnyHit>
@@ -148,6 +148,9 @@ class TriangleMesh {
     static constexpr std::size_t kCornerArrayLimit = 4096;
     std::vector<float> corners_;
     std::size_t stride_ = 0;
+    // A small mesh's unit face normals, worked out once as geometric_normal would for every hit
+    // (a cross product, a division and a square root); empty beside an empty corners_.
+    std::vector<Vec3> face_normals_;
     MeshTree tree_;
     std::shared_ptr<const MipMap> alpha_;  // null: no cut-outs
     std::size_t dropped_ = 0;
