@@ -242,16 +242,18 @@ std::uint32_t Bvh::build(std::vector<Build>& items, std::uint32_t begin, std::ui
 // Still spheres, the common case, inline; a moving sphere's segment and meshes out of line.
 template <bool kAnyHit>
 inline std::optional<double> Bvh::hit(const Primitive& p, const Ray& ray, double origin_scale,
-                                      Interval range, std::uint32_t& triangle, Vec2& uv) const {
+                                      Interval range, std::uint32_t skip, std::uint32_t& triangle,
+                                      Vec2& uv) const {
     if (p.kind == Kind::kStillSphere) {
         return intersect_sphere(p.centre, p.radius, ray, origin_scale, range);
     }
-    return hit_segment<kAnyHit>(p, ray, origin_scale, range, triangle, uv);
+    return hit_segment<kAnyHit>(p, ray, origin_scale, range, skip, triangle, uv);
 }
 
 template <bool kAnyHit>
 std::optional<double> Bvh::hit_segment(const Primitive& p, const Ray& ray, double origin_scale,
-                                       Interval range, std::uint32_t& triangle, Vec2& uv) const {
+                                       Interval range, std::uint32_t skip, std::uint32_t& triangle,
+                                       Vec2& uv) const {
     if (!p.time.contains(ray.time)) return std::nullopt;
     if (p.kind == Kind::kMovingSphere) {
         return intersect_sphere(motions_[p.motion].at(ray.time), p.radius, ray, origin_scale,
@@ -261,10 +263,10 @@ std::optional<double> Bvh::hit_segment(const Primitive& p, const Ray& ray, doubl
     const TriangleMesh& mesh = *meshes_[p.index].mesh;
     if constexpr (kAnyHit) {
         // A shadow ray needs no nearest hit: the mesh's first hit found ends its traversal.
-        if (!mesh.occluded(ray_in_mesh(ray, origin), range)) return std::nullopt;
+        if (!mesh.occluded(ray_in_mesh(ray, origin), range, skip)) return std::nullopt;
         return range.max;
     } else {
-        const auto hit = mesh.intersect(ray_in_mesh(ray, origin), range);
+        const auto hit = mesh.intersect(ray_in_mesh(ray, origin), range, skip);
         if (!hit) return std::nullopt;
         triangle = hit->triangle;
         uv = {hit->b.b1, hit->b.b2};
@@ -281,7 +283,8 @@ std::uint32_t Bvh::object_of(const Primitive& p, std::uint32_t triangle) const {
 }
 
 template <bool kAnyHit>
-bool Bvh::traverse(const Ray& ray, Interval& range, std::uint64_t planes, Nearest& nearest) const {
+bool Bvh::traverse(const Ray& ray, Interval& range, std::uint64_t planes, Leaving leaving,
+                   Nearest& nearest) const {
     const double origin_scale = max_abs_component(ray.origin);
     bool found = false;
     for (std::size_t i = 0; i < planes_.size(); ++i) {
@@ -302,10 +305,13 @@ bool Bvh::traverse(const Ray& ray, Interval& range, std::uint64_t planes, Neares
     auto leaf = [&](const Node& node) {
         for (std::uint32_t i = node.offset; i < node.offset + node.count; ++i) {
             const Primitive& p = primitives_[i];
-            if (auto t = hit<kAnyHit>(p, ray, origin_scale, range, triangle, uv)) {
+            const std::uint32_t skip =
+                leaving.piece == i ? leaving.triangle : TriangleMesh::kNoTriangle;
+            if (auto t = hit<kAnyHit>(p, ray, origin_scale, range, skip, triangle, uv)) {
                 if constexpr (kAnyHit) return true;
-                found = true,
-                nearest = {object_of(p, triangle), is_mesh(p.kind) ? triangle : p.index, uv};
+                found = true;
+                nearest = is_mesh(p.kind) ? Nearest{object_of(p, triangle), triangle, uv, i}
+                                          : Nearest{p.object, p.index, uv};
                 range.max = *t;
             }
         }
@@ -357,15 +363,15 @@ bool Bvh::traverse(const Ray& ray, Interval& range, std::uint64_t planes, Neares
     }
 }
 
-std::optional<Hit> Bvh::intersect(const Ray& ray, Interval range) const {
+std::optional<Hit> Bvh::intersect(const Ray& ray, Interval range, Leaving leaving) const {
     Nearest nearest;
-    if (!traverse<false>(ray, range, kAllPlanes, nearest)) return std::nullopt;
-    return Hit{range.max, objects_[nearest.object], nearest.index, nearest.uv};
+    if (!traverse<false>(ray, range, kAllPlanes, leaving, nearest)) return std::nullopt;
+    return Hit{range.max, objects_[nearest.object], nearest.index, nearest.uv, nearest.piece};
 }
 
-bool Bvh::occluded(const Ray& ray, Interval range, std::uint64_t planes) const {
+bool Bvh::occluded(const Ray& ray, Interval range, std::uint64_t planes, Leaving leaving) const {
     Nearest unused;
-    return traverse<true>(ray, range, planes, unused);
+    return traverse<true>(ray, range, planes, leaving, unused);
 }
 
 bool Bvh::occluded_by(const Ray& ray, Interval range, std::uint64_t planes,
@@ -384,7 +390,10 @@ bool Bvh::occluded_by(const Ray& ray, Interval range, std::uint64_t planes,
     std::uint32_t triangle = 0;
     Vec2 uv;
     for (const std::uint32_t i : primitives) {
-        if (hit<true>(primitives_[i], ray, origin_scale, range, triangle, uv)) return true;
+        if (hit<true>(primitives_[i], ray, origin_scale, range, TriangleMesh::kNoTriangle, triangle,
+                      uv)) {
+            return true;
+        }
     }
     return false;
 }

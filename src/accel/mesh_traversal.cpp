@@ -148,6 +148,7 @@ constexpr int kStackSize = 7 * 64 + 1;
 
 template <bool kAnyHit, bool kAlpha>
 TriangleMesh::Answer<kAnyHit> TriangleMesh::traverse(const Ray& ray, Interval range,
+                                                     std::uint32_t leaving,
                                                      std::uint64_t* tests) const {
     if (tree_.empty()) return {};
     // The per-ray set-up is a good part of a ray's cost: the double-precision sheared ray of the
@@ -237,6 +238,7 @@ TriangleMesh::Answer<kAnyHit> TriangleMesh::traverse(const Ray& ray, Interval ra
                 const auto lanes = std::min<std::uint32_t>(4, end - first);
                 if (tests) *tests += lanes;
                 int maybe = (1 << lanes) - 1;
+                if (leaving - first < lanes) maybe &= ~(1 << (leaving - first));
                 if constexpr (kAnyHit) {
                     // A triangle the filter proves the double test would hit answers the
                     // query without that test, which every blocked ray would otherwise run.
@@ -337,12 +339,14 @@ TriangleMesh::Answer<kAnyHit> TriangleMesh::traverse(const Ray& ray, Interval ra
     }
 }
 
-std::optional<MeshHit> TriangleMesh::intersect(const Ray& ray, Interval range) const {
-    return alpha_ ? traverse<false, true>(ray, range) : traverse<false>(ray, range);
+std::optional<MeshHit> TriangleMesh::intersect(const Ray& ray, Interval range,
+                                               std::uint32_t leaving) const {
+    return alpha_ ? traverse<false, true>(ray, range, leaving)
+                  : traverse<false>(ray, range, leaving);
 }
 
-bool TriangleMesh::occluded(const Ray& ray, Interval range) const {
-    return alpha_ ? traverse<true, true>(ray, range) : traverse<true>(ray, range);
+bool TriangleMesh::occluded(const Ray& ray, Interval range, std::uint32_t leaving) const {
+    return alpha_ ? traverse<true, true>(ray, range, leaving) : traverse<true>(ray, range, leaving);
 }
 
 bool TriangleMesh::opaque(std::uint32_t triangle, const Barycentrics& b) const {
@@ -358,9 +362,9 @@ bool TriangleMesh::opaque(std::uint32_t triangle, const Barycentrics& b) const {
 std::uint64_t TriangleMesh::triangle_tests(const Ray& ray, Interval range, bool any_hit) const {
     std::uint64_t tests = 0;
     if (any_hit) {
-        traverse<true>(ray, range, &tests);
+        traverse<true>(ray, range, kNoTriangle, &tests);
     } else {
-        traverse<false>(ray, range, &tests);
+        traverse<false>(ray, range, kNoTriangle, &tests);
     }
     return tests;
 }

@@ -100,8 +100,9 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth,
     return radiance(ray, s, depth, work);
 }
 
-Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, PixelWork& work) const {
-    const auto hit = bvh_.intersect(ray, {0, kInfinity});
+Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, PixelWork& work,
+                           Leaving leaving) const {
+    const auto hit = bvh_.intersect(ray, {0, kInfinity}, leaving);
     if (any_visible_light_) {
         double nearest = hit ? hit->t : kInfinity;
         const Light* seen = nullptr;
@@ -118,11 +119,17 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
     // Face both normals towards the incoming ray: planes are two-sided, and a ray inside a
     // sphere sees its inner side.
     const auto [outside, geometric, shading, above] = facing_normals(surface, ray.dir);
+    const Leaving from_hit = Bvh::leaving(*hit);
 
     Color result = m.emission;  // seen from either side
     if (m.has_diffuse()) {
-        Color light = scene_.ambient + direct_light(surface.light_point, above, shading, ray.time,
-                                                    s, depth, work.counts);
+        // Shadow rays leaving a smooth mesh's lifted point, or along its shading normal, may
+        // meet their own triangle.
+        const bool from_facet =
+            surface.light_point == surface.point && surface.light_normal == surface.normal;
+        Color light = scene_.ambient + direct_light(surface.light_point, above, shading,
+                                                    from_facet ? from_hit : Leaving{}, ray.time, s,
+                                                    depth, work.counts);
         // Light through glass and off mirrors: shadow rays never pass them, so it is counted
         // here only.
         if (photons_) light += photons_->caustic(s.seed, s.pass(), surface.point, geometric);
@@ -136,8 +143,8 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
         const double reflection_sigma = e.glossy_reflection ? m.sigma() : 0.0;
         const Vec3 ideal = reflect_above(ray.dir, shading, geometric);
         result += m.reflective * m.ks *
-                  scattered(surface.point, geometric, ideal, reflection_sigma, +1, ray.time, s,
-                            depth, dim::kGlossReflect, false, work);
+                  scattered(surface.point, geometric, from_hit, ideal, reflection_sigma, +1,
+                            ray.time, s, depth, dim::kGlossReflect, false, work);
     }
     if (m.transmits()) {
         const double sigma = m.sigma();
@@ -150,13 +157,13 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
         Color glass;
         if (fresnel > 0) {
             glass +=
-                fresnel * scattered(surface.point, geometric,
+                fresnel * scattered(surface.point, geometric, from_hit,
                                     reflect_above(ray.dir, shading, geometric), reflection_sigma,
                                     +1, ray.time, s, depth, dim::kGlassReflect, false, work);
         }
         if (fresnel < 1) {
             if (const auto through = refract_below(ray.dir, shading, geometric, eta)) {
-                glass += (1.0 - fresnel) * scattered(surface.point, geometric, *through,
+                glass += (1.0 - fresnel) * scattered(surface.point, geometric, from_hit, *through,
                                                      refraction_sigma, -1, ray.time, s, depth,
                                                      dim::kGlossRefract, true, work);
             }
@@ -166,9 +173,10 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
     return result;
 }
 
-Color Integrator::scattered(const Vec3& point, const Vec3& geometric, const Vec3& ideal,
-                            double sigma, double side, double time, const PixelSample& s, int depth,
-                            std::uint32_t kind, bool refraction, PixelWork& work) const {
+Color Integrator::scattered(const Vec3& point, const Vec3& geometric, Leaving leaving,
+                            const Vec3& ideal, double sigma, double side, double time,
+                            const PixelSample& s, int depth, std::uint32_t kind, bool refraction,
+                            PixelWork& work) const {
     const std::uint32_t dimension = dim::bounce(depth, kind);
     const int rays = sigma > 0 && depth == 0 ? scene_.settings.glossy_rays : 1;
     Color sum;
@@ -190,7 +198,8 @@ Color Integrator::scattered(const Vec3& point, const Vec3& geometric, const Vec3
             }
         }
         ++(refraction ? work.counts.refraction : work.counts.reflection);
-        sum += radiance(spawn_ray(point, geometric, dir, time), s.branch(kind, j), depth + 1, work);
+        sum += radiance(spawn_ray(point, geometric, dir, time), s.branch(kind, j), depth + 1, work,
+                        leaving);
     }
     return rays == 1 ? sum : sum / rays;
 }
@@ -206,8 +215,8 @@ Color Integrator::light_ray(const Light& light, const LightSample& ls, const Vec
 }
 
 Color Integrator::emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point, const Vec3& origin,
-                              const Vec3& geometric, const Vec3& shading, double time,
-                              RayCounts& counts) const {
+                              Leaving leaving, const Vec3& geometric, const Vec3& shading,
+                              double time, RayCounts& counts) const {
     const auto sample = plan_.emitters.sample(emitter, point, u, time);
     if (!sample) return {};
     const double cosine = lit_cosine(sample->dir, shading, geometric);
@@ -216,7 +225,7 @@ Color Integrator::emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point, co
     const bool point_light = plan_.emitters.is_point(emitter);
     // An emitting surface is in the BVH: the ray stops just short of it.
     const double reach = point_light ? sample->distance : sample->distance * kShortOfEmitter;
-    if (bvh_.occluded({origin, sample->dir, time}, {0, reach})) return {};
+    if (bvh_.occluded({origin, sample->dir, time}, {0, reach}, leaving)) return {};
     // In the units of the thesis's sum of lights, which the diffuse part multiplies by
     // diffuse·kd: irradiance over π, estimated as radiance·cos/pdf.
     if (point_light) return sample->radiance * cosine;
@@ -224,7 +233,7 @@ Color Integrator::emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point, co
 }
 
 Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const Vec3& shading,
-                               double time, const PixelSample& s, int depth,
+                               Leaving leaving, double time, const PixelSample& s, int depth,
                                RayCounts& counts) const {
     // Every shadow ray leaves on the geometric normal's side, so from the same spawned origin.
     const Vec3 origin = spawn_ray(point, geometric, geometric, time).origin;
@@ -283,7 +292,8 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
         for (int j = 0; j < rays; ++j) {
             const Vec2 u = rays == 1 ? sampler_.get_2d(s, dimension)
                                      : sampler_.get_2d_in_set(s, dimension, j, rays);
-            emitter_sum += emitter_ray(i, u, point, origin, geometric, shading, time, counts);
+            emitter_sum +=
+                emitter_ray(i, u, point, origin, leaving, geometric, shading, time, counts);
         }
         sum += rays == 1 ? emitter_sum : emitter_sum / rays;
     }
@@ -304,7 +314,8 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
                 std::clamp((u.x - lo) / p, 0.0, std::nextafter(1.0, 0.0));  // reuse within the pick
             if (k >= area_lights_.size()) {
                 const std::size_t emitter = plan_.area_emitters[k - area_lights_.size()];
-                sum += emitter_ray(emitter, u, point, origin, geometric, shading, time, counts) /
+                sum += emitter_ray(emitter, u, point, origin, leaving, geometric, shading, time,
+                                   counts) /
                        (p * rays);
                 continue;
             }

@@ -117,8 +117,9 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
     bool diffuse_seen = false;  // a diffuse event anywhere before
     Vec3 from;
     double scatter_density = 0;
+    Leaving leaving;  // the triangle the ray leaves from
     for (int depth = 0;; ++depth) {
-        const auto hit = bvh_.intersect(ray, {0, kInfinity});
+        const auto hit = bvh_.intersect(ray, {0, kInfinity}, leaving);
         // The thesis's visible lights are seen as in the distributed integrator; light from them
         // reaches diffuse surfaces by shadow rays alone.
         if (any_visible_light_ && !after_diffuse) {
@@ -181,8 +182,13 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
         const double diffuse_pick = diffuse_weight / total;
 
         if (diffuse_weight > 0) {
-            Color light = next_event(surface.light_point, above, shading, ray.time, s, depth,
-                                     diffuse_pick, counts);
+            // Shadow rays leaving a smooth mesh's lifted point, or along its shading normal,
+            // may meet their own triangle.
+            const bool from_facet =
+                surface.light_point == surface.point && surface.light_normal == surface.normal;
+            Color light = next_event(surface.light_point, above, shading,
+                                     from_facet ? Bvh::leaving(*hit) : Leaving{}, ray.time, s,
+                                     depth, diffuse_pick, counts);
             if (photons_) light += photons_->caustic(s.seed, s.pass(), surface.point, geometric);
             result += throughput * diffuse_colour * light;
         }
@@ -245,6 +251,7 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
             }
         }
         ray = spawn_ray(surface.point, geometric, dir, ray.time);
+        leaving = Bvh::leaving(*hit);
     }
 }
 
@@ -262,19 +269,20 @@ Vec3 PathIntegrator::perturbed(const Vec3& ideal, double sigma, double side, con
 }
 
 Color PathIntegrator::light_ray(const Light& light, Vec2 u, const Vec3& point, const Vec3& origin,
-                                const Vec3& geometric, const Vec3& shading, double time,
-                                RayCounts& counts) const {
+                                Leaving leaving, const Vec3& geometric, const Vec3& shading,
+                                double time, RayCounts& counts) const {
     const LightSample ls = light.sample(point, u);
     const double cosine = lit_cosine(ls.dir, shading, geometric);
     if (cosine == 0) return {};
     ++counts.shadow;
-    if (bvh_.occluded({origin, ls.dir, time}, {0, ls.distance})) return {};
+    if (bvh_.occluded({origin, ls.dir, time}, {0, ls.distance}, leaving)) return {};
     return light.intensity() * cosine;
 }
 
 Color PathIntegrator::emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point,
-                                  const Vec3& origin, const Vec3& geometric, const Vec3& shading,
-                                  double time, double diffuse_pick, RayCounts& counts) const {
+                                  const Vec3& origin, Leaving leaving, const Vec3& geometric,
+                                  const Vec3& shading, double time, double diffuse_pick,
+                                  RayCounts& counts) const {
     const auto sample = plan_.emitters.sample(emitter, point, u, time);
     if (!sample) return {};
     const double cosine = lit_cosine(sample->dir, shading, geometric);
@@ -282,7 +290,7 @@ Color PathIntegrator::emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point
     ++counts.shadow;
     const bool point_light = plan_.emitters.is_point(emitter);
     const double reach = point_light ? sample->distance : sample->distance * kShortOfEmitter;
-    if (bvh_.occluded({origin, sample->dir, time}, {0, reach})) return {};
+    if (bvh_.occluded({origin, sample->dir, time}, {0, reach}, leaving)) return {};
     if (point_light) return sample->radiance * cosine;
     const double weight =
         strategy_ == Strategy::kMis
@@ -292,8 +300,8 @@ Color PathIntegrator::emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point
 }
 
 Color PathIntegrator::next_event(const Vec3& point, const Vec3& geometric, const Vec3& shading,
-                                 double time, const PixelSample& s, int depth, double diffuse_pick,
-                                 RayCounts& counts) const {
+                                 Leaving leaving, double time, const PixelSample& s, int depth,
+                                 double diffuse_pick, RayCounts& counts) const {
     const Vec3 origin = spawn_ray(point, geometric, geometric, time).origin;
     const bool emitters = strategy_ != Strategy::kScatterOnly;
     const auto point_of = [&](std::uint32_t dimension, int j, int rays) {
@@ -307,7 +315,7 @@ Color PathIntegrator::next_event(const Vec3& point, const Vec3& geometric, const
         Color light_sum;
         for (int j = 0; j < rays; ++j) {
             light_sum += light_ray(*scene_.lights[i], point_of(path_dim::light(depth, i), j, rays),
-                                   point, origin, geometric, shading, time, counts);
+                                   point, origin, leaving, geometric, shading, time, counts);
         }
         if (rays > 0) sum += light_sum / rays;
     }
@@ -316,8 +324,8 @@ Color PathIntegrator::next_event(const Vec3& point, const Vec3& geometric, const
         const std::uint32_t dimension = path_dim::light(depth, scene_.lights.size() + i);
         Color emitter_sum;
         for (int j = 0; j < rays; ++j) {
-            emitter_sum += emitter_ray(i, point_of(dimension, j, rays), point, origin, geometric,
-                                       shading, time, diffuse_pick, counts);
+            emitter_sum += emitter_ray(i, point_of(dimension, j, rays), point, origin, leaving,
+                                       geometric, shading, time, diffuse_pick, counts);
         }
         if (rays > 0) sum += emitter_sum / rays;
     }
@@ -334,12 +342,12 @@ Color PathIntegrator::next_event(const Vec3& point, const Vec3& geometric, const
             const double p = cdf[k] - lo;
             u.x = std::clamp((u.x - lo) / p, 0.0, std::nextafter(1.0, 0.0));
             if (k < area_lights_.size()) {
-                sum += light_ray(*area_lights_[k], u, point, origin, geometric, shading, time,
-                                 counts) /
+                sum += light_ray(*area_lights_[k], u, point, origin, leaving, geometric, shading,
+                                 time, counts) /
                        (p * rays);
             } else if (emitters) {
                 sum += emitter_ray(plan_.area_emitters[k - area_lights_.size()], u, point, origin,
-                                   geometric, shading, time, diffuse_pick, counts) /
+                                   leaving, geometric, shading, time, diffuse_pick, counts) /
                        (p * rays);
             }
         }

@@ -11,6 +11,8 @@
 #include <optional>
 #include <vector>
 
+#include "drt/accel/mesh.h"
+#include "drt/accel/triangle_mesh.h"
 #include "drt/geometry/plane.h"
 #include "drt/geometry/sphere.h"
 #include "drt/render/integrator.h"
@@ -18,6 +20,8 @@
 #include "drt/sampling/sampler.h"
 #include "drt/scene/light.h"
 #include "drt/util/rng.h"
+#include "test_math.h"
+#include "test_meshes.h"
 #include "test_world.h"
 
 namespace drt {
@@ -160,6 +164,77 @@ TEST(Bvh, SurfaceOfAHitRecordIsWhereTheRayMetTheShape) {
     }
     EXPECT_GT(spheres, 100);
     EXPECT_GT(planes, 100);
+}
+
+// Rays spawned from mesh hits, as the integrators spawn them, skip the triangle they leave
+// (Leaving) and find exactly what they find without skipping it: the skip saves a test and
+// changes no answer. Inside a closed sphere of triangles, every spawned ray meets another.
+TEST(Bvh, RaysLeavingAMeshTriangleFindWhatTheyFindWithoutSkippingIt) {
+    Material material;
+    std::vector<std::unique_ptr<Object>> objects;
+    const auto sphere = std::make_shared<const TriangleMesh>(
+        testing::obj_of(testing::icosphere(3, 50, {3, -2, 7})), MeshTransform{}, false);
+    objects.push_back(std::make_unique<Mesh>(sphere, std::vector<Vec3>{Vec3{}}, material));
+    objects.push_back(std::make_unique<Sphere>(std::vector<Vec3>{{13, -2, 7}}, 8.0, material));
+    const Bvh bvh(objects);
+    int nearest = 0, blocked = 0;
+    for (std::uint64_t i = 0; i < 3000; ++i) {
+        const Ray ray{Vec3{3, -2, 7} + testing::unit_vector(40, i) * 20, direction(41, i)};
+        const auto hit = bvh.intersect(ray, {0, kInfinity});
+        ASSERT_TRUE(hit) << i;
+        if (hit->object != objects[0].get()) continue;
+        ASSERT_NE(hit->piece, Hit::kNoPiece);
+        const SurfaceHit surface = hit->object->surface_at(ray, *hit);
+        const Ray next = spawn_ray(surface.point, surface.normal, direction(42, i), 0);
+        const auto expected = bvh.intersect(next, {0, kInfinity});
+        const auto got = bvh.intersect(next, {0, kInfinity}, Bvh::leaving(*hit));
+        ASSERT_EQ(got.has_value(), expected.has_value()) << i;
+        if (!got) continue;
+        ++nearest;
+        EXPECT_EQ(got->t, expected->t) << i;
+        EXPECT_EQ(got->object, expected->object) << i;
+        EXPECT_EQ(got->primitive, expected->primitive) << i;
+        EXPECT_NE(got->primitive, hit->primitive) << i;
+        const Interval range{0, 2 * expected->t * unit(43, i)};
+        const bool occluded = bvh.occluded(next, range);
+        EXPECT_EQ(bvh.occluded(next, range, Bvh::leaving(*hit)), occluded) << i;
+        blocked += occluded;
+    }
+    EXPECT_GT(nearest, 1000);
+    EXPECT_GT(blocked, 300);
+    EXPECT_LT(blocked, nearest - 300);
+}
+
+// The skip names a triangle of one placed piece: the same mesh placed again, one unit above,
+// is met by the ray leaving the first placement's copy of the same triangle.
+TEST(Bvh, ALeavingRaySkipsItsOwnPlacementOfASharedMeshAlone) {
+    Material material;
+    testing::TestMesh flat;
+    flat.vertices = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}};
+    flat.triangles = {{0, 1, 2}};
+    const auto triangle =
+        std::make_shared<const TriangleMesh>(testing::obj_of(flat), MeshTransform{}, false);
+    std::vector<std::unique_ptr<Object>> objects;
+    objects.push_back(std::make_unique<Mesh>(triangle, std::vector<Vec3>{Vec3{}}, material));
+    objects.push_back(std::make_unique<Mesh>(triangle, std::vector<Vec3>{Vec3{0, 0, 1}}, material));
+    const Bvh bvh(objects);
+    const Ray up{{1, 1, -3}, {0, 0, 1}};
+    const auto first = bvh.intersect(up, {0, kInfinity});
+    ASSERT_TRUE(first);
+    EXPECT_EQ(first->object, objects[0].get());
+    const Ray on = spawn_ray(up.at(first->t), {0, 0, 1}, {0, 0, 1}, 0);
+    const auto second = bvh.intersect(on, {0, kInfinity}, Bvh::leaving(*first));
+    ASSERT_TRUE(second);
+    EXPECT_EQ(second->object, objects[1].get());
+    EXPECT_EQ(second->primitive, first->primitive);
+    EXPECT_NEAR(second->t, 1.0, 1e-8);
+    EXPECT_TRUE(bvh.occluded(on, {0, 2}, Bvh::leaving(*first)));
+    // Told to skip it, even a ray that does meet the first triangle passes it untested.
+    const auto past = bvh.intersect(up, {0, kInfinity}, Bvh::leaving(*first));
+    ASSERT_TRUE(past);
+    EXPECT_EQ(past->object, objects[1].get());
+    EXPECT_FALSE(bvh.occluded(up, {0, 3.5}, Bvh::leaving(*first)));
+    EXPECT_TRUE(bvh.occluded(up, {0, 3.5}));
 }
 
 TEST(FastKernels, SinCosOfTurnsIsWithinTwoUlpsAndExactAtQuarters) {

@@ -158,6 +158,38 @@ TEST(TriangleMesh, NearestHitIsThatOfTestingEveryTriangle) {
     }
 }
 
+// The triangle a query is told the ray leaves is not tested at all: a ray through the front of
+// a sphere of triangles told to skip the front triangle finds the back one, as testing every
+// other triangle does, and is not blocked before it.
+TEST(TriangleMesh, SkipsTheTriangleTheRayLeavesAndNoOther) {
+    const TriangleMesh mesh(testing::obj_of(testing::icosphere(3)), {}, false);
+    int tested = 0;
+    for (std::uint64_t r = 0; r < 2000; ++r) {
+        const Vec3 target = testing::unit_vector(16, r) * (0.9 * to_unit(hash_of(17, r, 0)));
+        const Vec3 origin = testing::unit_vector(18, r) * 3.0;
+        const Ray ray{origin, normalize(target - origin)};
+        const auto front = mesh.intersect(ray, {0, kInfinity});
+        ASSERT_TRUE(front) << "ray " << r;
+        std::optional<MeshHit> expected;
+        for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+            if (t == front->triangle) continue;
+            const auto [a, b, c] = mesh.corners(t);
+            const auto hit = intersect_triangle(ray, a, b, c, {0, kInfinity});
+            if (hit && (!expected || hit->t < expected->t)) expected = MeshHit{hit->t, t, hit->b};
+        }
+        const auto found = mesh.intersect(ray, {0, kInfinity}, front->triangle);
+        ASSERT_EQ(found.has_value(), expected.has_value()) << "ray " << r;
+        if (!found) continue;
+        ++tested;
+        EXPECT_EQ(found->triangle, expected->triangle) << "ray " << r;
+        EXPECT_EQ(found->t, expected->t) << "ray " << r;
+        const Interval before_back{0, 0.5 * (front->t + found->t)};
+        EXPECT_TRUE(mesh.occluded(ray, before_back));
+        EXPECT_FALSE(mesh.occluded(ray, before_back, front->triangle)) << "ray " << r;
+    }
+    EXPECT_GT(tested, 1900);
+}
+
 // A mesh of one leaf is tested without its root's box (mesh_traversal.cpp), through the corner
 // arrays' lanes past its end: 1 to 8 crossing triangles, each kept where the file put it, and
 // hit as testing each of them finds, from in front, from behind and by rays that miss.

@@ -19,13 +19,25 @@
 
 namespace drt {
 
+// The mesh triangle a ray leaves from, which a Bvh's queries skip untested
+// (TriangleMesh::kNoTriangle): only for a ray that starts just off the plane of a triangle the
+// Bvh hit, heading away from it, as spawn_ray makes them. Other rays leave nothing.
+struct Leaving {
+    std::uint32_t piece = Hit::kNoPiece;
+    std::uint32_t triangle = 0;
+};
+
 class Bvh {
   public:
     explicit Bvh(const std::vector<std::unique_ptr<Object>>& objects);
 
-    std::optional<Hit> intersect(const Ray& ray, Interval range) const;
+    // The triangle a ray leaves from, skipped untested (Leaving).
+    static Leaving leaving(const Hit& hit) { return {hit.piece, hit.primitive}; }
+    std::optional<Hit> intersect(const Ray& ray, Interval range, Leaving leaving = {}) const;
     // Whether anything blocks the ray within range (any hit will do, so it stops at the first).
-    bool occluded(const Ray& ray, Interval range) const { return occluded(ray, range, kAllPlanes); }
+    bool occluded(const Ray& ray, Interval range, Leaving leaving = {}) const {
+        return occluded(ray, range, kAllPlanes, leaving);
+    }
 
     std::size_t node_count() const { return nodes_.size(); }
 
@@ -40,7 +52,7 @@ class Bvh {
     std::span<const PlaneData> planes() const { return planes_; }
     // Whether the ray is blocked within range by a plane whose bit is set in `planes` (planes
     // past the 64th always count) or by anything in the tree.
-    bool occluded(const Ray& ray, Interval range, std::uint64_t planes) const;
+    bool occluded(const Ray& ray, Interval range, std::uint64_t planes, Leaving leaving = {}) const;
     // The same, testing only the listed primitives (as visit_near names them) of the tree.
     bool occluded_by(const Ray& ray, Interval range, std::uint64_t planes,
                      std::span<const std::uint32_t> primitives) const;
@@ -102,21 +114,25 @@ class Bvh {
     struct Nearest {
         std::uint32_t object = 0, index = 0;
         Vec2 uv;
+        std::uint32_t piece = Hit::kNoPiece;
     };
     // Whether the ray hits anything within range; the nearest hit (or, for kAnyHit, the first
     // found) shrinks range.max to its t and is described in `nearest`.
     template <bool kAnyHit>
-    bool traverse(const Ray& ray, Interval& range, std::uint64_t planes, Nearest& nearest) const;
+    bool traverse(const Ray& ray, Interval& range, std::uint64_t planes, Leaving leaving,
+                  Nearest& nearest) const;
     // The one leaf test: the ray parameter inside `range` at which the ray meets primitive p at
     // the ray's time. A mesh writes the triangle it hit and its barycentrics b1, b2 into
     // `triangle` and `uv`. For kAnyHit, a mesh answers with any hit, range.max for its t and
-    // nothing written.
+    // nothing written. A mesh skips triangle `skip` (TriangleMesh::kNoTriangle: none).
     template <bool kAnyHit>
     std::optional<double> hit(const Primitive& p, const Ray& ray, double origin_scale,
-                              Interval range, std::uint32_t& triangle, Vec2& uv) const;
+                              Interval range, std::uint32_t skip, std::uint32_t& triangle,
+                              Vec2& uv) const;
     template <bool kAnyHit>
     std::optional<double> hit_segment(const Primitive& p, const Ray& ray, double origin_scale,
-                                      Interval range, std::uint32_t& triangle, Vec2& uv) const;
+                                      Interval range, std::uint32_t skip, std::uint32_t& triangle,
+                                      Vec2& uv) const;
     // Where primitive p is at `time`, as a ball (for the shadow-ray culling).
     Ball ball_at(const Primitive& p, double time) const {
         if (p.kind == Kind::kStillSphere) return {p.centre, p.radius};

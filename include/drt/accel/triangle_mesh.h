@@ -67,10 +67,15 @@ class TriangleMesh {
     bool has_alpha() const { return alpha_ != nullptr; }
     bool opaque(std::uint32_t triangle, const Barycentrics& b) const;
 
+    // A ray that leaves a triangle from just off its plane, heading away from it, cannot meet
+    // it, but the float filter cannot tell so from that close: the queries skip the triangle
+    // named `leaving` untested (kNoTriangle: none), which changes no answer.
+    static constexpr std::uint32_t kNoTriangle = ~std::uint32_t{0};
     // Nearest hit inside `range` of a ray given in the mesh's own coordinates.
-    std::optional<MeshHit> intersect(const Ray& ray, Interval range) const;
+    std::optional<MeshHit> intersect(const Ray& ray, Interval range,
+                                     std::uint32_t leaving = kNoTriangle) const;
     // Whether any triangle meets the ray inside `range` (stops at the first).
-    bool occluded(const Ray& ray, Interval range) const;
+    bool occluded(const Ray& ray, Interval range, std::uint32_t leaving = kNoTriangle) const;
     // How many triangles the query (nearest hit, or any hit) tests on its way, counting every
     // triangle of a batch of up to four tested together: what the hierarchy saves, for tests
     // and benchmarks.
@@ -129,7 +134,8 @@ class TriangleMesh {
     // The query (mesh_traversal.cpp); `tests`, when given, counts the triangles tested.
     // kAlpha: hits on cut-out points are passed over (set_alpha).
     template <bool kAnyHit, bool kAlpha = false>
-    Answer<kAnyHit> traverse(const Ray& ray, Interval range, std::uint64_t* tests = nullptr) const;
+    Answer<kAnyHit> traverse(const Ray& ray, Interval range, std::uint32_t leaving,
+                             std::uint64_t* tests = nullptr) const;
 
     Vec3 origin_;
     std::vector<Float3> positions_;  // relative to origin_

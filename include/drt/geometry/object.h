@@ -33,6 +33,10 @@ struct Hit {
     // barycentrics b1, b2, from which a mesh interpolates normals). Spheres and planes leave
     // them 0: their surface follows exactly from the point ray.at(t) projected onto them.
     Vec2 uv;
+    // The accelerator's own number for the piece of geometry hit, by which a ray leaving the hit
+    // skips it (Bvh::Leaving); kNoPiece where no accelerator found the hit.
+    static constexpr std::uint32_t kNoPiece = ~std::uint32_t{0};
+    std::uint32_t piece = kNoPiece;
 };
 
 // What the integrator needs to know about the point a ray hit.

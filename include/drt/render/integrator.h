@@ -26,8 +26,10 @@ namespace drt {
 Ray spawn_ray(const Vec3& point, const Vec3& normal, const Vec3& dir, double time);
 
 // A shadow ray towards a point on an emitting surface (which the BVH holds) ends this fraction of
-// the way there, so that rounding cannot make the emitter block its own light.
-inline constexpr double kShortOfEmitter = 1 - 1e-6;
+// the way there, so that rounding cannot make the emitter block its own light; and far enough
+// short (about 100 float roundings) that a mesh's float filter rules the emitter's triangles
+// out without the double-precision test.
+inline constexpr double kShortOfEmitter = 1 - 1e-5;
 
 // A direction about `ideal` whose angle from it is Rayleigh-distributed with scale sigma, i.e.
 // a 2-D normal distribution of standard deviation sigma (radians) on the tangent plane.
@@ -68,10 +70,14 @@ class Integrator final : public PixelIntegrator {
         RunPoints points;  // of the glossy dimensions
     };
 
-    Color radiance(const Ray& ray, const PixelSample& s, int depth, PixelWork& work) const;
-    // Σ lights at a point: I · max(0, N·ω) · visibility, averaged over each light's shadow rays.
-    Color direct_light(const Vec3& point, const Vec3& geometric, const Vec3& shading, double time,
-                       const PixelSample& s, int depth, RayCounts& counts) const;
+    // `leaving`: the triangle the ray leaves from, which it skips (bvh.h).
+    Color radiance(const Ray& ray, const PixelSample& s, int depth, PixelWork& work,
+                   Leaving leaving = {}) const;
+    // Σ lights at a point: I · max(0, N·ω) · visibility, averaged over each light's shadow rays;
+    // emitters' shadow rays skip the triangle `leaving`.
+    Color direct_light(const Vec3& point, const Vec3& geometric, const Vec3& shading,
+                       Leaving leaving, double time, const PixelSample& s, int depth,
+                       RayCounts& counts) const;
     // One shadow ray from `origin` (spawned off the shading point) along a light sample.
     Color light_ray(const Light& light, const LightSample& ls, const Vec3& origin,
                     const Vec3& geometric, const Vec3& shading, double time,
@@ -79,13 +85,14 @@ class Integrator final : public PixelIntegrator {
     // One shadow ray towards emitter `emitter` (emitters.h) for the point u of the unit square,
     // in the units of direct_light.
     Color emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point, const Vec3& origin,
-                      const Vec3& geometric, const Vec3& shading, double time,
+                      Leaving leaving, const Vec3& geometric, const Vec3& shading, double time,
                       RayCounts& counts) const;
     // Average radiance along `rays` directions about `ideal` (one exactly ideal ray if sigma is
-    // 0), each redrawn until it leaves on the `side` of the surface (+1 = the normal's side).
-    Color scattered(const Vec3& point, const Vec3& geometric, const Vec3& ideal, double sigma,
-                    double side, double time, const PixelSample& s, int depth, std::uint32_t kind,
-                    bool refraction, PixelWork& work) const;
+    // 0), each redrawn until it leaves on the `side` of the surface (+1 = the normal's side),
+    // skipping the triangle `leaving`.
+    Color scattered(const Vec3& point, const Vec3& geometric, Leaving leaving, const Vec3& ideal,
+                    double sigma, double side, double time, const PixelSample& s, int depth,
+                    std::uint32_t kind, bool refraction, PixelWork& work) const;
 
     const Scene& scene_;
     const RenderPlan& plan_;

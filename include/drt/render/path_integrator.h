@@ -46,15 +46,16 @@ class PathIntegrator final : public PixelIntegrator {
     // Light from the lights and emitters reaching `point` (the shading point shadow rays leave
     // from) by one shadow ray each, in the units of the thesis's sum of lights (irradiance over
     // π), emitters' weighed against a diffuse scattered ray chosen with probability
-    // `diffuse_pick`.
-    Color next_event(const Vec3& point, const Vec3& geometric, const Vec3& shading, double time,
-                     const PixelSample& s, int depth, double diffuse_pick, RayCounts& counts) const;
+    // `diffuse_pick`. Shadow rays skip the triangle `leaving` (bvh.h).
+    Color next_event(const Vec3& point, const Vec3& geometric, const Vec3& shading, Leaving leaving,
+                     double time, const PixelSample& s, int depth, double diffuse_pick,
+                     RayCounts& counts) const;
     Color light_ray(const Light& light, Vec2 u, const Vec3& point, const Vec3& origin,
-                    const Vec3& geometric, const Vec3& shading, double time,
+                    Leaving leaving, const Vec3& geometric, const Vec3& shading, double time,
                     RayCounts& counts) const;
     Color emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point, const Vec3& origin,
-                      const Vec3& geometric, const Vec3& shading, double time, double diffuse_pick,
-                      RayCounts& counts) const;
+                      Leaving leaving, const Vec3& geometric, const Vec3& shading, double time,
+                      double diffuse_pick, RayCounts& counts) const;
     // A direction about `ideal` with angular spread sigma (exactly `ideal` for 0) leaving on the
     // `side` of the surface (+1: the normal's), redrawn as the distributed integrator does.
     Vec3 perturbed(const Vec3& ideal, double sigma, double side, const Vec3& geometric,
