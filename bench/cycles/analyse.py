@@ -44,6 +44,7 @@ for scene in scenes:
           f", all {pfm.mean(b) / pfm.mean(a):.4f}; relative RMSE between them "
           f"{pfm.relative_rmse(b, a):.4f}")
     curves = {}
+    startups = {}  # per renderer: wall less start-up-excluded time, every run at every level
     renderers = [n for n in ("drt", "drt-sobol", "cycles")
                  if any(k[:2] == (scene, n) for k in by_key)]
     for renderer in renderers:
@@ -61,6 +62,7 @@ for scene in scenes:
             cpu = [t[2] for t in times]
             points.append((spp, corrected, statistics.median(wall), statistics.median(render),
                            statistics.median(cpu)))
+            startups.setdefault(renderer, []).extend(w - r for w, r in zip(wall, render))
             print(f"  {spp:6d} {measured:.5f} {corrected:.5f}  {statistics.median(wall):8.3f} "
                   f"({min(wall):.3f}-{max(wall):.3f})  {statistics.median(render):8.3f} "
                   f"({min(render):.3f}-{max(render):.3f})  {statistics.median(cpu):8.2f}")
@@ -92,14 +94,21 @@ for scene in scenes:
         a, b = fit(points, column)
         return spp, a + b * spp, mark
 
+    def startup(renderer):
+        """The start-up a run adds to its start-up-excluded time: the median over every run.
+        Start-up included, a renderer's time is its start-up-excluded line plus this, not a line
+        fitted to the wall clocks: Blender's start-up varies by seconds from run to run, which
+        would tilt such a line, and extrapolated far enough it would fall below the start-up-
+        excluded one."""
+        return statistics.median(startups[renderer])
+
     for renderer in renderers:
         pts = curves[renderer]
         slope = math.log(pts[-1][1] / pts[0][1]) / math.log(pts[-1][0] / pts[0][0])
         a_ex, b_ex = fit(pts, 3)
-        a_in, b_in = fit(pts, 2)
         print(f"{renderer}: slope of error against spp {slope:.3f}; fixed cost {a_ex:.3f} s "
-              f"excluded, {a_in:.3f} s included; per 1000 spp {1000 * b_ex:.3f} s excluded, "
-              f"{1000 * b_in:.3f} s included")
+              f"excluded, start-up {startup(renderer):.3f} s (median); per 1000 spp "
+              f"{1000 * b_ex:.3f} s")
 
     print("time to reach (s): target; per renderer spp, start-up excluded, included, CPU; "
           "then Cycles' time / drt's (excluded, included, CPU)")
@@ -108,7 +117,7 @@ for scene in scenes:
         reached = {}
         for renderer in renderers:
             spp, ex, mark = reach(curves[renderer], t, 3)
-            _, inc, _ = reach(curves[renderer], t, 2)
+            inc = ex + startup(renderer)
             _, cpu, _ = reach(curves[renderer], t, 4)
             reached[renderer] = (ex, inc, cpu)
             line += f" | {renderer} {spp:6.0f}{mark}spp {ex:7.2f} {inc:7.2f} {cpu:7.2f}"

@@ -7,7 +7,8 @@
 # serves both drt runs), then renders at each of --levels spp, drt, drt-sobol, then Cycles,
 # round after round on --threads threads; bench/cycles/analyse.py prints each one's
 # relative RMSE against its own reference and the time to reach 2 %, 1 % and 0.5 %, start-up
-# included (the process's wall clock) and excluded (Cycles: its log, from the first sample to
+# included (the excluded time plus the median of each run's wall clock less its excluded time)
+# and excluded (Cycles: its log, from the first sample to
 # Finished; drt: the wall clock less that of the same command at 1 spp, run each round: drt
 # runs without --stats, which would add its error estimate's renders, 30 % of the samples on
 # an image this small), and the two references' agreement.
