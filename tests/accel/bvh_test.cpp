@@ -194,7 +194,9 @@ TEST(Bvh, RaysLeavingAMeshTriangleFindWhatTheyFindWithoutSkippingIt) {
         EXPECT_EQ(got->t, expected->t) << i;
         EXPECT_EQ(got->object, expected->object) << i;
         EXPECT_EQ(got->primitive, expected->primitive) << i;
-        EXPECT_NE(got->primitive, hit->primitive) << i;
+        if (got->object == hit->object) {
+            EXPECT_NE(got->primitive, hit->primitive) << i;
+        }
         const Interval range{0, 2 * expected->t * unit(43, i)};
         const bool occluded = bvh.occluded(next, range);
         EXPECT_EQ(bvh.occluded(next, range, Bvh::leaving(*hit)), occluded) << i;
