@@ -249,6 +249,8 @@ void TriangleMesh::make_corner_arrays() {
                 corners_[static_cast<std::size_t>(3 * v + a) * stride_ + i] = positions_[t[v]][a];
         }
     }
+    // Worked out into a vector of their own first: geometric_normal reads face_normals_ once
+    // it is filled.
     std::vector<Vec3> normals(count);
     for (std::uint32_t t = 0; t < count; ++t) normals[t] = geometric_normal(t);
     face_normals_ = std::move(normals);

@@ -123,12 +123,8 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
 
     Color result = m.emission;  // seen from either side
     if (m.has_diffuse()) {
-        // Shadow rays leaving a smooth mesh's lifted point, or along its shading normal, may
-        // meet their own triangle.
-        const bool from_facet =
-            surface.light_point == surface.point && surface.light_normal == surface.normal;
         Color light = scene_.ambient + direct_light(surface.light_point, above, shading,
-                                                    from_facet ? from_hit : Leaving{}, ray.time, s,
+                                                    shadow_leaving(surface, *hit), ray.time, s,
                                                     depth, work.counts);
         // Light through glass and off mirrors: shadow rays never pass them, so it is counted
         // here only.

@@ -182,13 +182,9 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
         const double diffuse_pick = diffuse_weight / total;
 
         if (diffuse_weight > 0) {
-            // Shadow rays leaving a smooth mesh's lifted point, or along its shading normal,
-            // may meet their own triangle.
-            const bool from_facet =
-                surface.light_point == surface.point && surface.light_normal == surface.normal;
-            Color light = next_event(surface.light_point, above, shading,
-                                     from_facet ? Bvh::leaving(*hit) : Leaving{}, ray.time, s,
-                                     depth, diffuse_pick, counts);
+            Color light =
+                next_event(surface.light_point, above, shading, shadow_leaving(surface, *hit),
+                           ray.time, s, depth, diffuse_pick, counts);
             if (photons_) light += photons_->caustic(s.seed, s.pass(), surface.point, geometric);
             result += throughput * diffuse_colour * light;
         }

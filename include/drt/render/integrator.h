@@ -25,6 +25,14 @@ namespace drt {
 // error of a re-projected hit point, and still invisible (2.3e-5 at 1e5 from the origin).
 Ray spawn_ray(const Vec3& point, const Vec3& normal, const Vec3& dir, double time);
 
+// The triangle a hit's shadow rays skip (bvh.h): its own, unless they leave from a smooth mesh's
+// lifted point or along its shading normal, from where they may meet it.
+inline Leaving shadow_leaving(const SurfaceHit& surface, const Hit& hit) {
+    const bool from_facet =
+        surface.light_point == surface.point && surface.light_normal == surface.normal;
+    return from_facet ? Bvh::leaving(hit) : Leaving{};
+}
+
 // A shadow ray towards a point on an emitting surface (which the BVH holds) ends this fraction of
 // the way there, so that rounding cannot make the emitter block its own light; and far enough
 // short (about 100 float roundings) that a mesh's float filter rules the emitter's triangles
