@@ -6,6 +6,7 @@
 #include <climits>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -195,12 +196,46 @@ std::vector<std::size_t> RenderContext::rendered_in(const Tile& tile,
     return rendered;
 }
 
+struct RenderContext::PixelRun {
+    PixelRun(const RenderRequest& request_, const Tile& tile_, std::vector<std::size_t> rendered_)
+        : request(request_),
+          tile(tile_),
+          rendered(std::move(rendered_)),
+          pixels(static_cast<std::size_t>(tile.width()) * static_cast<std::size_t>(tile.height())) {
+    }
+
+    // rendered[k]'s place in the image.
+    int x(std::size_t k) const { return tile.x0 + static_cast<int>(rendered[k] % width()); }
+    int y(std::size_t k) const { return tile.y0 + static_cast<int>(rendered[k] / width()); }
+    std::size_t width() const { return static_cast<std::size_t>(tile.width()); }
+    // The next of `rendered` to render, as its index there; none once all are handed out.
+    std::optional<std::size_t> take() {
+        const std::size_t k = next.fetch_add(1, std::memory_order_relaxed);
+        return k < rendered.size() ? std::optional(k) : std::nullopt;
+    }
+    std::size_t left() const {
+        const std::size_t handed = next.load(std::memory_order_relaxed);
+        return handed < rendered.size() ? rendered.size() - handed : 0;
+    }
+
+    const RenderRequest& request;
+    const Tile tile;
+    const std::vector<std::size_t> rendered;  // the tile's pixels rendered, row by row
+    std::vector<Pixel> pixels;                // every pixel of the tile, row by row
+    std::atomic<std::size_t> next{0};
+    // Pixels the helpers have rendered; their values and rays are written before the count.
+    std::atomic<std::size_t> helped{0};
+    std::mutex mutex;
+    RayCounts helpers_rays;  // guarded by mutex
+};
+
 TileBuffer RenderContext::render_tile(const Tile& tile, const RenderRequest& request) const {
     return *render_tile(tile, request, std::stop_token{});
 }
 
 std::optional<TileBuffer> RenderContext::render_tile(const Tile& tile, const RenderRequest& request,
-                                                     const std::stop_token& stop) const {
+                                                     const std::stop_token& stop,
+                                                     Workbench* bench) const {
     TileBuffer buffer{tile, Image(tile.width(), tile.height()),
                       {},   Image(tile.width(), tile.height()),
                       {},   {},
@@ -208,13 +243,43 @@ std::optional<TileBuffer> RenderContext::render_tile(const Tile& tile, const Ren
                       {}};
     const auto width = static_cast<std::size_t>(tile.width());
     Scratch scratch;
-    std::vector<Pixel> pixels(width * static_cast<std::size_t>(tile.height()));
-    const std::vector<std::size_t> rendered = rendered_in(tile, request);
-    for (const std::size_t i : rendered) {
-        if (stop.stop_requested()) return std::nullopt;
-        pixels[i] = render_pixel(request, tile.x0 + static_cast<int>(i % width),
-                                 tile.y0 + static_cast<int>(i / width), 0, scratch, buffer.rays);
+    const auto run = std::make_shared<PixelRun>(request, tile, rendered_in(tile, request));
+    std::size_t own = 0;
+    {
+        // On the bench while this thread takes pixels, however it leaves.
+        const struct Opened {
+            Workbench* bench;
+            const std::shared_ptr<PixelRun>& run;
+            Opened(Workbench* b, const std::shared_ptr<PixelRun>& r) : bench(b), run(r) {
+                if (!bench) return;
+                const std::lock_guard lock(bench->mutex_);
+                bench->open_.push_back(run);
+                bench->changed_.notify_all();
+            }
+            ~Opened() {
+                if (!bench) return;
+                const std::lock_guard lock(bench->mutex_);
+                std::erase(bench->open_, run);
+            }
+            Opened(const Opened&) = delete;
+            Opened& operator=(const Opened&) = delete;
+        } opened(bench, run);
+        while (const auto k = run->take()) {
+            if (stop.stop_requested()) return std::nullopt;
+            run->pixels[run->rendered[*k]] =
+                render_pixel(request, run->x(*k), run->y(*k), 0, scratch, buffer.rays);
+            ++own;
+        }
     }
+    // Every pixel is handed out: wait for those the helpers took. A helper renders every pixel
+    // it takes, stop or not, so the count comes.
+    const std::size_t helped = run->rendered.size() - own;
+    for (std::size_t done; (done = run->helped.load(std::memory_order_acquire)) < helped;) {
+        run->helped.wait(done, std::memory_order_acquire);
+    }
+    buffer.rays += run->helpers_rays;
+    const std::vector<Pixel>& pixels = run->pixels;
+    const std::vector<std::size_t>& rendered = run->rendered;
     buffer.pixel_samples.reserve(pixels.size());
     for (std::size_t i = 0; i < pixels.size(); ++i) {
         const Pixel& pixel = pixels[i];
@@ -247,6 +312,46 @@ std::optional<TileBuffer> RenderContext::render_tile(const Tile& tile, const Ren
         if (!calibrate(request, tile, pixels, rendered, scratch, buffer, stop)) return std::nullopt;
     }
     return buffer;
+}
+
+void RenderContext::Workbench::taken_all() {
+    const std::lock_guard lock(mutex_);
+    --takers_;
+    changed_.notify_all();
+}
+
+std::size_t RenderContext::help(Workbench& bench, const std::stop_token& stop) const {
+    Scratch scratch;
+    std::size_t rendered = 0;
+    while (true) {
+        std::shared_ptr<PixelRun> run;  // the open tile with the most pixels left
+        {
+            std::unique_lock lock(bench.mutex_);
+            const auto pick = [&] {
+                std::size_t most = 0;
+                for (const auto& open : bench.open_) {
+                    if (open->left() > most) most = open->left(), run = open;
+                }
+                return run != nullptr || bench.takers_ == 0;
+            };
+            bench.changed_.wait(lock, stop, pick);
+        }
+        if (!run || stop.stop_requested()) return rendered;
+        while (!stop.stop_requested()) {
+            const auto k = run->take();
+            if (!k) break;
+            RayCounts rays;
+            run->pixels[run->rendered[*k]] =
+                render_pixel(run->request, run->x(*k), run->y(*k), 0, scratch, rays);
+            {
+                const std::lock_guard lock(run->mutex);
+                run->helpers_rays += rays;
+            }
+            run->helped.fetch_add(1, std::memory_order_release);
+            run->helped.notify_one();
+            ++rendered;
+        }
+    }
 }
 
 std::uint64_t RenderContext::tile_cost(const Tile& tile, const RenderRequest& request) const {

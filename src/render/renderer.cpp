@@ -23,25 +23,41 @@ double seconds_since(Clock::time_point start) {
 int render_tiles(const RenderContext& context, const RenderRequest& request, TileSource& source,
                  TileSink& sink, const RenderOptions& options) {
     context.check(request);
-    const int threads =
-        std::max(1, std::min(worker_threads(options.threads), static_cast<int>(source.size())));
+    // Threads beyond the tiles help render their pixels.
+    const int threads = source.size() > 0 ? worker_threads(options.threads) : 1;
     std::atomic<std::size_t> tiles_done{0};
     const double total = static_cast<double>(std::max<std::size_t>(1, source.size()));
     const auto progress = [&] { options.on_progress(double(tiles_done.load()) / total); };
+    // A thread out of tiles helps render the pixels of those still in hand.
+    RenderContext::Workbench bench(threads);
+    RenderContext::Workbench* const shared = threads > 1 ? &bench : nullptr;
     run_on_threads(
         threads,
         [&](const std::atomic<bool>& failed) {
-            while (!failed.load(std::memory_order_relaxed) && !options.stop.stop_requested()) {
-                const std::optional<Tile> tile = source.next();
-                if (!tile) break;
-                std::optional<TileBuffer> done = context.render_tile(*tile, request, options.stop);
-                if (!done) {
-                    source.give_back(*tile);
-                    break;
+            bool out_of_tiles = false;
+            {
+                // However the loop ends, this thread opens no more tiles.
+                const struct Leave {
+                    RenderContext::Workbench& bench;
+                    ~Leave() { bench.taken_all(); }
+                } leave{bench};
+                while (!failed.load(std::memory_order_relaxed) && !options.stop.stop_requested()) {
+                    const std::optional<Tile> tile = source.next();
+                    if (!tile) {
+                        out_of_tiles = true;
+                        break;
+                    }
+                    std::optional<TileBuffer> done =
+                        context.render_tile(*tile, request, options.stop, shared);
+                    if (!done) {
+                        source.give_back(*tile);
+                        break;
+                    }
+                    sink.add(std::move(*done));
+                    tiles_done.fetch_add(1, std::memory_order_relaxed);
                 }
-                sink.add(std::move(*done));
-                tiles_done.fetch_add(1, std::memory_order_relaxed);
             }
+            if (out_of_tiles && shared) context.help(*shared, options.stop);
         },
         options.on_progress ? std::function<void()>(progress) : nullptr);
     if (options.on_progress) progress();

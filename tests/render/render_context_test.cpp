@@ -1,11 +1,14 @@
 // The cost guess that orders the tiles: shaded rays the probes trace, scaled to the tile, and the
 // order it gives (which changes no pixel: renderer_test.cpp renders tiles in any order); requests
-// against one context: without the error estimate, one pixel per block, listed pixels paired.
+// against one context: without the error estimate, one pixel per block, listed pixels paired;
+// a tile's pixels shared with a helping thread.
 #include "drt/render/render_context.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <optional>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -110,6 +113,38 @@ TEST(RenderContext, WithoutTheEstimateRendersTheSamePixelsAndNoneTwice) {
         calibrated += a.error_sums;
     }
     EXPECT_GE(calibrated.pixels, 64);  // 8 % of 9,216 pixels rendered twice on average
+}
+
+TEST(RenderContext, HelpersRenderATilesPixelsAsItsOwnThreadWould) {
+    Scene scene = mirror_ball();
+    scene.settings.samples = 64;
+    const RenderContext context(scene);
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
+    const Tile& tile = context.tiles()[14];  // beside the centre: all mirror
+    const TileBuffer alone = context.render_tile(tile, request);
+
+    RenderContext::Workbench bench(1);  // the owner below
+    std::optional<TileBuffer> shared;
+    std::size_t helped = 0;
+    {
+        const std::jthread owner([&] {
+            shared = context.render_tile(tile, request, {}, &bench);
+            bench.taken_all();
+        });
+        // Waits for the owner's tile, helps with it, and returns once the owner takes no more.
+        helped = context.help(bench, {});
+    }
+    ASSERT_TRUE(shared);
+    EXPECT_GT(helped, 0u);
+    EXPECT_LE(helped, 256u);
+    EXPECT_EQ(shared->pixels.rgb, alone.pixels.rgb);
+    EXPECT_EQ(shared->spread.rgb, alone.spread.rgb);
+    EXPECT_EQ(shared->pixel_samples, alone.pixel_samples);
+    EXPECT_EQ(shared->error_sums, alone.error_sums);
+    EXPECT_EQ(shared->samples, alone.samples);
+    EXPECT_EQ(shared->rays.camera, alone.rays.camera);
+    EXPECT_EQ(shared->rays.reflection, alone.rays.reflection);
+    EXPECT_EQ(shared->rays.total(), alone.rays.total());
 }
 
 // One pixel in block x block of `scene`'s image.

@@ -87,6 +87,25 @@ TEST(Renderer, TilesInAnyOrderGiveTheWholeRendersBits) {
     }
 }
 
+TEST(Renderer, ThreadsBeyondTheTilesHelpWithTheirPixelsAndChangeNoBit) {
+    Scene scene = small_scene("thesis/test6.xml", 16);  // one tile
+    scene.settings.samples = 16;
+    const RenderContext context(scene);
+    ASSERT_EQ(context.tiles().size(), 1u);
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
+    ImageSink alone(scene.settings.width, scene.settings.height, context.tiles());
+    ImageSink helped(scene.settings.width, scene.settings.height, context.tiles());
+    TileQueue one(context.tiles()), three(context.tiles());
+    EXPECT_EQ(render_tiles(context, request, one, alone, on_threads(1)), 1);
+    EXPECT_EQ(render_tiles(context, request, three, helped, on_threads(3)), 3);
+    EXPECT_TRUE(same_bits(helped.image(), alone.image()));
+    EXPECT_TRUE(same_bits(helped.spread(), alone.spread()));
+    expect_same_counts(helped.rays(), alone.rays());
+    EXPECT_EQ(helped.rays().diffuse, alone.rays().diffuse);
+    EXPECT_EQ(helped.samples(), alone.samples());
+    EXPECT_EQ(helped.error_sums(), alone.error_sums());
+}
+
 TEST(Renderer, TileBuffersRayCountsSumToTheWholeRenders) {
     for (const std::string& name : kScenes) {
         SCOPED_TRACE(name);

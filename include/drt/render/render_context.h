@@ -4,8 +4,10 @@
 // request and the tile, so any process holding the same scene renders the same bits for it.
 #pragma once
 
+#include <condition_variable>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <stop_token>
@@ -23,6 +25,9 @@
 namespace drt {
 
 class RenderContext {
+    // A tile's pixels, handed out one at a time to the thread rendering it and to helpers.
+    struct PixelRun;
+
   public:
     // Throws std::invalid_argument for an unknown sampler name. The scene's samples and seed are
     // not read: each request brings its own.
@@ -55,12 +60,39 @@ class RenderContext {
     // How many pixels renders() picks.
     std::uint64_t rendered_pixels(const RenderRequest& request) const;
 
+    // Tiles whose pixels are being rendered, open to threads that have no tile of their own
+    // left: rather than wait idle for the last tiles to finish (the render's tail, a good part
+    // of a small image's few tiles), they render some of those tiles' pixels (help). A pixel is
+    // the same whichever thread renders it, and a tile's buffer the same however many helped.
+    class Workbench {
+      public:
+        // `takers`: the threads that will take tiles of their own and render them here.
+        explicit Workbench(int takers) : takers_(takers) {}
+        Workbench(const Workbench&) = delete;
+        Workbench& operator=(const Workbench&) = delete;
+        // Said once by each of those threads when it takes no more tiles, however it stops:
+        // until all have, a helper waits for tiles still to come.
+        void taken_all();
+
+      private:
+        friend class RenderContext;
+        std::mutex mutex_;
+        std::condition_variable_any changed_;  // a tile opened, or a taker said taken_all
+        std::vector<std::shared_ptr<PixelRun>> open_;
+        int takers_;
+    };
+
     // Renders the pixels of `tile` that `request` picks. Safe to call from several threads.
     TileBuffer render_tile(const Tile& tile, const RenderRequest& request) const;
     // The same, abandoned between two pixels once `stop` is requested: a tile of thousands of
     // samples a pixel takes seconds, too long to keep a person who stopped the render waiting.
+    // With a workbench, the tile's pixels are open there to helpers while it renders them.
     std::optional<TileBuffer> render_tile(const Tile& tile, const RenderRequest& request,
-                                          const std::stop_token& stop) const;
+                                          const std::stop_token& stop,
+                                          Workbench* bench = nullptr) const;
+    // Renders pixels of the tiles open on `bench` until no tile has any left to hand out and no
+    // taker will open another, or until `stop` is requested; returns how many it rendered.
+    std::size_t help(Workbench& bench, const std::stop_token& stop) const;
 
     // A guess at what render_tile(tile, request) costs, in shaded rays (camera, reflection and
     // refraction rays: shadow rays left out, cheap beside the shading they serve): those one camera

@@ -57,7 +57,7 @@ class TileSource {
   public:
     virtual ~TileSource() = default;
     virtual std::optional<Tile> next() = 0;
-    // Tiles this source expects to hand out in all: caps the worker threads, scales progress.
+    // Tiles this source expects to hand out in all: scales progress.
     virtual std::size_t size() const = 0;
     // A tile handed out and then abandoned by a stop. Left alone it is simply missing from the
     // image (the render's unfinished tiles); a source serving another process returns it there.
