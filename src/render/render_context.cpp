@@ -197,10 +197,12 @@ std::vector<std::size_t> RenderContext::rendered_in(const Tile& tile,
 }
 
 struct RenderContext::PixelRun {
-    PixelRun(const RenderRequest& request_, const Tile& tile_, std::vector<std::size_t> rendered_)
+    PixelRun(const RenderRequest& request_, const Tile& tile_, std::vector<std::size_t> rendered_,
+             std::uint64_t path_)
         : request(request_),
           tile(tile_),
           rendered(std::move(rendered_)),
+          path(path_),
           pixels(static_cast<std::size_t>(tile.width()) * static_cast<std::size_t>(tile.height())) {
     }
 
@@ -221,6 +223,7 @@ struct RenderContext::PixelRun {
     const RenderRequest& request;
     const Tile tile;
     const std::vector<std::size_t> rendered;  // the tile's pixels rendered, row by row
+    const std::uint64_t path;                 // render_pixel's
     std::vector<Pixel> pixels;                // every pixel of the tile, row by row
     std::atomic<std::size_t> next{0};
     // Pixels the helpers have rendered; their values and rays are written before the count.
@@ -229,21 +232,9 @@ struct RenderContext::PixelRun {
     RayCounts helpers_rays;  // guarded by mutex
 };
 
-TileBuffer RenderContext::render_tile(const Tile& tile, const RenderRequest& request) const {
-    return *render_tile(tile, request, std::stop_token{});
-}
-
-std::optional<TileBuffer> RenderContext::render_tile(const Tile& tile, const RenderRequest& request,
-                                                     const std::stop_token& stop,
-                                                     Workbench* bench) const {
-    TileBuffer buffer{tile, Image(tile.width(), tile.height()),
-                      {},   Image(tile.width(), tile.height()),
-                      {},   {},
-                      0,    0,
-                      {}};
-    const auto width = static_cast<std::size_t>(tile.width());
-    Scratch scratch;
-    const auto run = std::make_shared<PixelRun>(request, tile, rendered_in(tile, request));
+bool RenderContext::render_run(const std::shared_ptr<PixelRun>& run, Workbench* bench,
+                               const std::stop_token& stop, Scratch& scratch,
+                               RayCounts& rays) const {
     std::size_t own = 0;
     {
         // On the bench while this thread takes pixels, however it leaves.
@@ -265,9 +256,9 @@ std::optional<TileBuffer> RenderContext::render_tile(const Tile& tile, const Ren
             Opened& operator=(const Opened&) = delete;
         } opened(bench, run);
         while (const auto k = run->take()) {
-            if (stop.stop_requested()) return std::nullopt;
+            if (stop.stop_requested()) return false;
             run->pixels[run->rendered[*k]] =
-                render_pixel(request, run->x(*k), run->y(*k), 0, scratch, buffer.rays);
+                render_pixel(run->request, run->x(*k), run->y(*k), run->path, scratch, rays);
             ++own;
         }
     }
@@ -277,7 +268,26 @@ std::optional<TileBuffer> RenderContext::render_tile(const Tile& tile, const Ren
     for (std::size_t done; (done = run->helped.load(std::memory_order_acquire)) < helped;) {
         run->helped.wait(done, std::memory_order_acquire);
     }
-    buffer.rays += run->helpers_rays;
+    rays += run->helpers_rays;
+    return true;
+}
+
+TileBuffer RenderContext::render_tile(const Tile& tile, const RenderRequest& request) const {
+    return *render_tile(tile, request, std::stop_token{});
+}
+
+std::optional<TileBuffer> RenderContext::render_tile(const Tile& tile, const RenderRequest& request,
+                                                     const std::stop_token& stop,
+                                                     Workbench* bench) const {
+    TileBuffer buffer{tile, Image(tile.width(), tile.height()),
+                      {},   Image(tile.width(), tile.height()),
+                      {},   {},
+                      0,    0,
+                      {}};
+    const auto width = static_cast<std::size_t>(tile.width());
+    Scratch scratch;
+    const auto run = std::make_shared<PixelRun>(request, tile, rendered_in(tile, request), 0);
+    if (!render_run(run, bench, stop, scratch, buffer.rays)) return std::nullopt;
     const std::vector<Pixel>& pixels = run->pixels;
     const std::vector<std::size_t>& rendered = run->rendered;
     buffer.pixel_samples.reserve(pixels.size());
@@ -304,12 +314,14 @@ std::optional<TileBuffer> RenderContext::render_tile(const Tile& tile, const Ren
         }
     }
     if (request.paired) {
-        if (!render_again(request, tile, pixels, rendered, scratch, buffer, stop)) {
+        if (!render_again(request, tile, pixels, rendered, scratch, buffer, stop, bench)) {
             return std::nullopt;
         }
     } else if (request.estimate_error && spread_kind(request) == SpreadKind::kCalibrated &&
                request.samples >= 2) {
-        if (!calibrate(request, tile, pixels, rendered, scratch, buffer, stop)) return std::nullopt;
+        if (!calibrate(request, tile, pixels, rendered, scratch, buffer, stop, bench)) {
+            return std::nullopt;
+        }
     }
     return buffer;
 }
@@ -342,7 +354,7 @@ std::size_t RenderContext::help(Workbench& bench, const std::stop_token& stop) c
             if (!k) break;
             RayCounts rays;
             run->pixels[run->rendered[*k]] =
-                render_pixel(run->request, run->x(*k), run->y(*k), 0, scratch, rays);
+                render_pixel(run->request, run->x(*k), run->y(*k), run->path, scratch, rays);
             {
                 const std::lock_guard lock(run->mutex);
                 run->helpers_rays += rays;
@@ -382,8 +394,8 @@ constexpr std::uint64_t kSecondRenderPath = 0xca11b4a7e5eedULL;
 
 bool RenderContext::calibrate(const RenderRequest& request, const Tile& tile,
                               std::span<const Pixel> pixels, std::span<const std::size_t> rendered,
-                              Scratch& scratch, TileBuffer& buffer,
-                              const std::stop_token& stop) const {
+                              Scratch& scratch, TileBuffer& buffer, const std::stop_token& stop,
+                              Workbench* bench) const {
     // One pixel per block: every one twice, so that the estimate is their own mean squared
     // difference; a scale taken from some of them times the spreads of all follows a pixel's
     // error too loosely at few samples.
@@ -391,19 +403,23 @@ bool RenderContext::calibrate(const RenderRequest& request, const Tile& tile,
         request.pixels == PixelChoice::kOnePerBlock
             ? std::vector<double>(pixels.size(), 1.0)
             : calibration_odds(buffer.spread, calibration_share(double(rendered_pixels(request))));
-    // The second renders' rays stay out of the image's ray counts: they are the estimate's cost,
-    // which the sums count in camera samples.
-    RayCounts rays;
     const auto width = static_cast<std::size_t>(tile.width());
+    std::vector<std::size_t> picked;
     for (const std::size_t i : rendered) {
         const int x = tile.x0 + static_cast<int>(i % width);
         const int y = tile.y0 + static_cast<int>(i / width);
         const auto pixel = static_cast<std::uint32_t>(y * scene_.settings.width + x);
-        if (to_unit(hash_of(request.seed, pixel, kSecondRenderPath)) >= odds[i]) continue;
-        if (stop.stop_requested()) return false;
-        const Pixel again = render_pixel(request, x, y, kSecondRenderPath, scratch, rays);
-        add_calibration(buffer.error_sums, pixels[i].value, again.value, pixels[i].spread, odds[i],
-                        again.samples);
+        if (to_unit(hash_of(request.seed, pixel, kSecondRenderPath)) < odds[i]) picked.push_back(i);
+    }
+    // The second renders' rays stay out of the image's ray counts: they are the estimate's cost,
+    // which the sums count in camera samples.
+    RayCounts rays;
+    const auto again = std::make_shared<PixelRun>(request, tile, picked, kSecondRenderPath);
+    if (!render_run(again, bench, stop, scratch, rays)) return false;
+    // Added up in the pixels' order, whoever rendered them.
+    for (const std::size_t i : picked) {
+        add_calibration(buffer.error_sums, pixels[i].value, again->pixels[i].value,
+                        pixels[i].spread, odds[i], again->pixels[i].samples);
     }
     return true;
 }
@@ -411,20 +427,23 @@ bool RenderContext::calibrate(const RenderRequest& request, const Tile& tile,
 bool RenderContext::render_again(const RenderRequest& request, const Tile& tile,
                                  std::span<const Pixel> pixels,
                                  std::span<const std::size_t> rendered, Scratch& scratch,
-                                 TileBuffer& buffer, const std::stop_token& stop) const {
+                                 TileBuffer& buffer, const std::stop_token& stop,
+                                 Workbench* bench) const {
+    const auto again = std::make_shared<PixelRun>(
+        request, tile, std::vector<std::size_t>(rendered.begin(), rendered.end()),
+        kSecondRenderPath);
+    if (!render_run(again, bench, stop, scratch, buffer.rays)) return false;
     const auto width = static_cast<std::size_t>(tile.width());
     for (const std::size_t i : rendered) {
-        if (stop.stop_requested()) return false;
         const int x = static_cast<int>(i % width), y = static_cast<int>(i / width);
-        const Pixel again = render_pixel(request, tile.x0 + x, tile.y0 + y, kSecondRenderPath,
-                                         scratch, buffer.rays);
+        const Pixel& second = again->pixels[i];
         const Color first = pixels[i].value;
-        const Color difference = first - again.value;
-        buffer.pixels.set(x, y, (first + again.value) * 0.5);
+        const Color difference = first - second.value;
+        buffer.pixels.set(x, y, (first + second.value) * 0.5);
         // (a - b)^2 / 4 has the variance of (a + b) / 2 as its expectation, whatever the pattern.
         buffer.spread.set(x, y, difference * difference * 0.25);
-        buffer.pixel_samples[i] += again.samples;
-        buffer.samples += again.samples;
+        buffer.pixel_samples[i] += second.samples;
+        buffer.samples += second.samples;
     }
     return true;
 }

@@ -133,17 +133,21 @@ class RenderContext {
                          Scratch& scratch, RayCounts& rays) const;
     // The pixels of `tile` that renders() picks, as indices row by row into the tile.
     std::vector<std::size_t> rendered_in(const Tile& tile, const RenderRequest& request) const;
+    // Renders the run's pixels on this thread and, with a bench, on any helping; adds their
+    // rays to `rays`. False if `stop` came first.
+    bool render_run(const std::shared_ptr<PixelRun>& run, Workbench* bench,
+                    const std::stop_token& stop, Scratch& scratch, RayCounts& rays) const;
     // Renders some of the tile's `rendered` pixels a second time for the error estimate's
     // calibration (error_estimate.h) and adds them to the buffer's error sums; `pixels` are all
     // the tile's, row by row. False if `stop` came first.
     bool calibrate(const RenderRequest& request, const Tile& tile, std::span<const Pixel> pixels,
                    std::span<const std::size_t> rendered, Scratch& scratch, TileBuffer& buffer,
-                   const std::stop_token& stop) const;
+                   const std::stop_token& stop, Workbench* bench) const;
     // A paired request's second render of each of the tile's `rendered` pixels: averaged into
     // the buffer's pixels, the pair's difference its spread. False if `stop` came first.
     bool render_again(const RenderRequest& request, const Tile& tile, std::span<const Pixel> pixels,
                       std::span<const std::size_t> rendered, Scratch& scratch, TileBuffer& buffer,
-                      const std::stop_token& stop) const;
+                      const std::stop_token& stop, Workbench* bench) const;
 
     const Scene& scene_;
     std::unique_ptr<Sampler> sampler_;
