@@ -1,11 +1,13 @@
 // BVH traversal over 10, 1,000 and 100,000 spheres, still and moving: nearest hit of rays from
-// outside the cloud (camera rays) and any hit of segments inside it (shadow rays), per ray.
+// outside the cloud (camera rays) and any hit of segments inside it (shadow rays), per ray; the
+// same in the Cornell box's mesh.
 #include <benchmark/benchmark.h>
 
 #include "bench_world.h"
 #include "drt/accel/bvh.h"
 #include "drt/accel/occluders.h"
 #include "drt/geometry/plane.h"
+#include "drt/scene/scene_loader.h"
 
 namespace drt::bench {
 namespace {
@@ -83,6 +85,43 @@ void BM_RoomShadowRays(benchmark::State& state) {
     state.counters["blocked_fraction"] = double(blocked) / double(9 * state.iterations());
 }
 BENCHMARK(BM_RoomShadowRays)->ArgName("gathered")->Arg(0)->Arg(1);
+
+// The Cornell box of the Cycles race (scenes/gi/cornell-box.xml: one mesh of 38 triangles):
+// nearest hits of rays from points inside the box in uniform directions, or shadow rays from
+// those points to points on the lamp, stopped short of it as the path integrator stops them.
+void BM_CornellBoxRays(benchmark::State& state) {
+    const LoadedScene loaded = load_scene(DRT_SOURCE_DIR "/scenes/gi/cornell-box.xml");
+    const Bvh bvh(loaded.scene.objects);
+    const bool shadow = state.range(0) != 0;
+    std::vector<Ray> rays;
+    std::vector<double> lengths;
+    for (int i = 0; i < kRays; ++i) {
+        const Vec3 origin{1 + 554 * unit(14, i), 1 + 546 * unit(15, i), 1 + 557 * unit(16, i)};
+        Vec3 d;
+        double reach = kInfinity;
+        if (shadow) {
+            const Vec3 lamp{213 + 130 * unit(17, i), 548.8, 227 + 105 * unit(18, i)};
+            d = lamp - origin;
+            reach = length(d) * (1 - 1e-5);
+        } else {
+            const double z = 2 * unit(17, i) - 1, r = std::sqrt(1 - z * z);
+            const double phi = 2 * kPi * unit(18, i);
+            d = {r * std::cos(phi), r * std::sin(phi), z};
+        }
+        rays.push_back({origin, d / length(d), 0});
+        lengths.push_back(reach);
+    }
+    std::size_t i = 0, hits = 0;
+    for (auto _ : state) {
+        const bool hit = shadow ? bvh.occluded(rays[i], {0, lengths[i]})
+                                : bvh.intersect(rays[i], {0, kInfinity}).has_value();
+        hits += hit;
+        benchmark::DoNotOptimize(hit);
+        i = (i + 1) % kRays;
+    }
+    state.counters["hit_fraction"] = double(hits) / double(state.iterations());
+}
+BENCHMARK(BM_CornellBoxRays)->ArgName("shadow")->Arg(0)->Arg(1);
 
 // Arguments: sphere count, moving (0/1).
 void world_sizes(benchmark::internal::Benchmark* b) {
