@@ -5,6 +5,7 @@
 #include <atomic>
 #include <climits>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <mutex>
 #include <numeric>
@@ -229,7 +230,8 @@ struct RenderContext::PixelRun {
     // Pixels the helpers have rendered; their values and rays are written before the count.
     std::atomic<std::size_t> helped{0};
     std::mutex mutex;
-    RayCounts helpers_rays;  // guarded by mutex
+    RayCounts helpers_rays;    // guarded by mutex
+    std::exception_ptr error;  // the first a helper threw; guarded by mutex
 };
 
 bool RenderContext::render_run(const std::shared_ptr<PixelRun>& run, Workbench* bench,
@@ -268,6 +270,7 @@ bool RenderContext::render_run(const std::shared_ptr<PixelRun>& run, Workbench* 
     for (std::size_t done; (done = run->helped.load(std::memory_order_acquire)) < helped;) {
         run->helped.wait(done, std::memory_order_acquire);
     }
+    if (run->error) std::rethrow_exception(run->error);
     rays += run->helpers_rays;
     return true;
 }
@@ -326,10 +329,15 @@ std::optional<TileBuffer> RenderContext::render_tile(const Tile& tile, const Ren
     return buffer;
 }
 
-void RenderContext::Workbench::taken_all() {
-    const std::lock_guard lock(mutex_);
-    --takers_;
-    changed_.notify_all();
+RenderContext::Workbench::Taker::Taker(Workbench& bench) : bench_(bench) {
+    const std::lock_guard lock(bench_.mutex_);
+    ++bench_.takers_;
+}
+
+RenderContext::Workbench::Taker::~Taker() {
+    const std::lock_guard lock(bench_.mutex_);
+    --bench_.takers_;
+    bench_.changed_.notify_all();
 }
 
 std::size_t RenderContext::help(Workbench& bench, const std::stop_token& stop) const {
@@ -353,14 +361,22 @@ std::size_t RenderContext::help(Workbench& bench, const std::stop_token& stop) c
             const auto k = run->take();
             if (!k) break;
             RayCounts rays;
-            run->pixels[run->rendered[*k]] =
-                render_pixel(run->request, run->x(*k), run->y(*k), run->path, scratch, rays);
+            std::exception_ptr error;
+            try {
+                run->pixels[run->rendered[*k]] =
+                    render_pixel(run->request, run->x(*k), run->y(*k), run->path, scratch, rays);
+            } catch (...) {
+                error = std::current_exception();
+            }
             {
                 const std::lock_guard lock(run->mutex);
                 run->helpers_rays += rays;
+                if (error && !run->error) run->error = error;
             }
+            // Counted even when it threw, so that the owner does not wait for it forever.
             run->helped.fetch_add(1, std::memory_order_release);
             run->helped.notify_one();
+            if (error) std::rethrow_exception(error);
             ++rendered;
         }
     }

@@ -29,18 +29,14 @@ int render_tiles(const RenderContext& context, const RenderRequest& request, Til
     const double total = static_cast<double>(std::max<std::size_t>(1, source.size()));
     const auto progress = [&] { options.on_progress(double(tiles_done.load()) / total); };
     // A thread out of tiles helps render the pixels of those still in hand.
-    RenderContext::Workbench bench(threads);
+    RenderContext::Workbench bench;
     RenderContext::Workbench* const shared = threads > 1 ? &bench : nullptr;
     run_on_threads(
         threads,
         [&](const std::atomic<bool>& failed) {
             bool out_of_tiles = false;
             {
-                // However the loop ends, this thread opens no more tiles.
-                const struct Leave {
-                    RenderContext::Workbench& bench;
-                    ~Leave() { bench.taken_all(); }
-                } leave{bench};
+                const RenderContext::Workbench::Taker taker(bench);
                 while (!failed.load(std::memory_order_relaxed) && !options.stop.stop_requested()) {
                     const std::optional<Tile> tile = source.next();
                     if (!tile) {

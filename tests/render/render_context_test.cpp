@@ -140,12 +140,14 @@ TEST(RenderContext, HelpersRenderATilesPixelsAsItsOwnThreadWould) {
         // busy machine that can happen, so the owner renders the tile again until one did.
         std::size_t helped = 0;
         for (int attempt = 0; attempt < 20 && helped == 0; ++attempt) {
-            RenderContext::Workbench bench(1);  // the owner below
+            RenderContext::Workbench bench;
+            // The owner's, taken before the helper looks and given up once the tile is done.
+            std::optional<RenderContext::Workbench::Taker> taker(std::in_place, bench);
             std::optional<TileBuffer> shared;
             {
                 const std::jthread owner([&] {
                     shared = context.render_tile(tile, request, {}, &bench);
-                    bench.taken_all();
+                    taker.reset();
                 });
                 // Waits for the owner's tile, helps with it, and returns once the owner takes
                 // no more.

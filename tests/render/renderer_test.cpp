@@ -6,13 +6,16 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstring>
 #include <mutex>
 #include <new>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <stop_token>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "drt/render/tile.h"
@@ -316,6 +319,39 @@ class FailingLight final : public Light {
     bool is_point() const override { return true; }
     std::optional<double> intersect(const Ray&, Interval) const override { return std::nullopt; }
 };
+
+// A point light that throws on every thread but the first to sample it, and is slow on that
+// one: on an image of one tile, the thread helping with it throws while its owner still works.
+class FailingElsewhereLight final : public Light {
+  public:
+    FailingElsewhereLight() : Light({1, 1, 1}, false) {}
+    using Light::sample;
+    LightSample sample(const Vec3& x, Vec2) const override {
+        {
+            const std::lock_guard lock(mutex_);
+            if (!first_) first_ = std::this_thread::get_id();
+            if (*first_ != std::this_thread::get_id()) throw std::bad_alloc();
+        }
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+        const Vec3 to = Vec3{0, 100, 0} - x;
+        return {normalize(to), length(to)};
+    }
+    Ball extent() const override { return {{0, 100, 0}, 0}; }
+    bool is_point() const override { return true; }
+    std::optional<double> intersect(const Ray&, Interval) const override { return std::nullopt; }
+
+  private:
+    mutable std::mutex mutex_;
+    mutable std::optional<std::thread::id> first_;
+};
+
+TEST(Renderer, AnExceptionOnAHelpingThreadReachesTheCallerAndLeavesNoOneWaiting) {
+    Scene scene = testing::floor_scene(16, 16);
+    scene.lights.clear();
+    scene.lights.push_back(std::make_unique<FailingElsewhereLight>());
+    ASSERT_EQ(RenderContext(scene).tiles().size(), 1u);
+    EXPECT_THROW(render(scene, on_threads(2)), std::bad_alloc);
+}
 
 TEST(Renderer, AnExceptionInsideATileReachesTheCaller) {
     Scene scene = testing::floor_scene(48, 32);

@@ -66,20 +66,31 @@ class RenderContext {
     // the same whichever thread renders it, and a tile's buffer the same however many helped.
     class Workbench {
       public:
-        // `takers`: the threads that will take tiles of their own and render them here.
-        explicit Workbench(int takers) : takers_(takers) {}
+        Workbench() = default;
         Workbench(const Workbench&) = delete;
         Workbench& operator=(const Workbench&) = delete;
-        // Said once by each of those threads when it takes no more tiles, however it stops:
-        // until all have, a helper waits for tiles still to come.
-        void taken_all();
+
+        // Held by a thread that takes tiles of its own for as long as it may take another,
+        // from before it asks for its first: while any is held, a helper with nothing to do
+        // waits for tiles still to come rather than leave. A thread that never started holds
+        // none, so no helper waits for it.
+        class Taker {
+          public:
+            explicit Taker(Workbench& bench);
+            ~Taker();
+            Taker(const Taker&) = delete;
+            Taker& operator=(const Taker&) = delete;
+
+          private:
+            Workbench& bench_;
+        };
 
       private:
         friend class RenderContext;
         std::mutex mutex_;
-        std::condition_variable_any changed_;  // a tile opened, or a taker said taken_all
+        std::condition_variable_any changed_;  // a tile opened, or a taker left
         std::vector<std::shared_ptr<PixelRun>> open_;
-        int takers_;
+        int takers_ = 0;
     };
 
     // Renders the pixels of `tile` that `request` picks. Safe to call from several threads.
