@@ -430,10 +430,11 @@ bool RenderContext::calibrate(const RenderRequest& request, const Tile& tile,
     // The second renders' rays stay out of the image's ray counts: they are the estimate's cost,
     // which the sums count in camera samples.
     RayCounts rays;
-    const auto again = std::make_shared<PixelRun>(request, tile, picked, kSecondRenderPath);
+    const auto again =
+        std::make_shared<PixelRun>(request, tile, std::move(picked), kSecondRenderPath);
     if (!render_run(again, bench, stop, scratch, rays)) return false;
     // Added up in the pixels' order, whoever rendered them.
-    for (const std::size_t i : picked) {
+    for (const std::size_t i : again->rendered) {
         add_calibration(buffer.error_sums, pixels[i].value, again->pixels[i].value,
                         pixels[i].spread, odds[i], again->pixels[i].samples);
     }

@@ -277,20 +277,33 @@ TEST(Renderer, ATileInHandWhenTheStopComesIsAbandonedAndGivenBack) {
     expect_same_counts(sink.rays(), context.render_tile(context.tiles()[0], request).rays);
 }
 
-// A point light whose first sample requests a stop: the tile is left between two pixels.
-class StoppingLight final : public Light {
+// A point light 100 above the origin whose sampling the tests below instrument.
+class PointAbove : public Light {
   public:
-    explicit StoppingLight(std::stop_source stop)
-        : Light({1, 1, 1}, false), stop_(std::move(stop)) {}
+    PointAbove() : Light({1, 1, 1}, false) {}
     using Light::sample;
-    LightSample sample(const Vec3& x, Vec2) const override {
-        stop_.request_stop();
-        const Vec3 to = Vec3{0, 100, 0} - x;
-        return {normalize(to), length(to)};
-    }
-    Ball extent() const override { return {{0, 100, 0}, 0}; }
+    Ball extent() const override { return {kAt, 0}; }
     bool is_point() const override { return true; }
     std::optional<double> intersect(const Ray&, Interval) const override { return std::nullopt; }
+
+  protected:
+    static LightSample towards(const Vec3& x) {
+        const Vec3 to = kAt - x;
+        return {normalize(to), length(to)};
+    }
+
+  private:
+    static constexpr Vec3 kAt{0, 100, 0};
+};
+
+// A point light whose first sample requests a stop: the tile is left between two pixels.
+class StoppingLight final : public PointAbove {
+  public:
+    explicit StoppingLight(std::stop_source stop) : stop_(std::move(stop)) {}
+    LightSample sample(const Vec3& x, Vec2) const override {
+        stop_.request_stop();
+        return towards(x);
+    }
 
   private:
     mutable std::stop_source stop_;
@@ -310,22 +323,15 @@ TEST(Renderer, AStopInsideATileAbandonsItBeforeItsNextPixel) {
 }
 
 // A point light that cannot be sampled: every shading point's shadow ray throws.
-class FailingLight final : public Light {
+class FailingLight final : public PointAbove {
   public:
-    FailingLight() : Light({1, 1, 1}, false) {}
-    using Light::sample;
     LightSample sample(const Vec3&, Vec2) const override { throw std::bad_alloc(); }
-    Ball extent() const override { return {{0, 100, 0}, 0}; }
-    bool is_point() const override { return true; }
-    std::optional<double> intersect(const Ray&, Interval) const override { return std::nullopt; }
 };
 
 // A point light that throws on every thread but the first to sample it, and is slow on that
 // one: on an image of one tile, the thread helping with it throws while its owner still works.
-class FailingElsewhereLight final : public Light {
+class FailingElsewhereLight final : public PointAbove {
   public:
-    FailingElsewhereLight() : Light({1, 1, 1}, false) {}
-    using Light::sample;
     LightSample sample(const Vec3& x, Vec2) const override {
         {
             const std::lock_guard lock(mutex_);
@@ -333,12 +339,8 @@ class FailingElsewhereLight final : public Light {
             if (*first_ != std::this_thread::get_id()) throw std::bad_alloc();
         }
         std::this_thread::sleep_for(std::chrono::microseconds(200));
-        const Vec3 to = Vec3{0, 100, 0} - x;
-        return {normalize(to), length(to)};
+        return towards(x);
     }
-    Ball extent() const override { return {{0, 100, 0}, 0}; }
-    bool is_point() const override { return true; }
-    std::optional<double> intersect(const Ray&, Interval) const override { return std::nullopt; }
 
   private:
     mutable std::mutex mutex_;
