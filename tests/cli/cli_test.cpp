@@ -24,12 +24,15 @@
 #include <vector>
 
 #include "drt/io/image.h"
+#include "encoded_bytes.h"
 #include "regex_match.h"
 #include "run_drt.h"
 #include "temp_folder.h"
 
 namespace drt {
 namespace {
+
+using testing::be32;
 
 namespace fs = std::filesystem;
 using namespace test;
@@ -376,13 +379,7 @@ TEST_F(CliTest, InfoDescribesAGoodSceneAndRejectsABadOne) {
 
 // ---- image files -------------------------------------------------------------------------------
 
-std::uint32_t be32(const std::string& s, std::size_t at) {
-    std::uint32_t v = 0;
-    for (int k = 0; k < 4; ++k) v = v << 8 | static_cast<unsigned char>(s[at + k]);
-    return v;
-}
-
-std::int32_t le32(const std::string& s, std::size_t at) {
+std::int32_t signed_le32(const std::string& s, std::size_t at) {
     std::uint32_t v = 0;
     for (int k = 3; k >= 0; --k) v = v << 8 | static_cast<unsigned char>(s[at + k]);
     return static_cast<std::int32_t>(v);
@@ -405,9 +402,9 @@ TEST_F(CliTest, PngBmpAndPfmHeadersCarryTheRequestedSize) {
     const std::string bmp = read_bytes(file("a.bmp"));
     ASSERT_GE(bmp.size(), 54u);
     EXPECT_EQ(bmp.substr(0, 2), "BM");
-    EXPECT_EQ(le32(bmp, 2), static_cast<std::int32_t>(bmp.size()));
-    EXPECT_EQ(le32(bmp, 18), 19);
-    EXPECT_EQ(std::abs(le32(bmp, 22)), 7);
+    EXPECT_EQ(signed_le32(bmp, 2), static_cast<std::int32_t>(bmp.size()));
+    EXPECT_EQ(signed_le32(bmp, 18), 19);
+    EXPECT_EQ(std::abs(signed_le32(bmp, 22)), 7);
 
     const std::string pfm = read_bytes(file("a.pfm"));
     const std::string header = "PF\n19 7\n-1.0\n";

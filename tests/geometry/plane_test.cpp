@@ -10,19 +10,15 @@
 
 #include "drt/util/rng.h"
 #include "test_math.h"
+#include "test_scenes.h"
 
 namespace drt {
 namespace {
 
+using testing::kEps;
 using testing::near;
+using testing::plain_material;
 using testing::unit_vector;
-
-constexpr double kEps = std::numeric_limits<double>::epsilon();
-
-const Material& plain_material() {
-    static const Material material{};
-    return material;
-}
 
 // Reports the texture coordinates it is evaluated at as its colour.
 class RecordingTexture final : public Texture {

@@ -7,14 +7,12 @@
 
 #include "drt/geometry/plane.h"
 #include "drt/geometry/sphere.h"
+#include "test_scenes.h"
 
 namespace drt {
 namespace {
 
-const Material& plain_material() {
-    static const Material material{};
-    return material;
-}
+using testing::plain_material;
 
 // Shows the (u, v) it is looked up at as its colour (u, v, 0).
 class UvTexture final : public Texture {

@@ -225,7 +225,7 @@ TEST(PredictedSeconds, CountsTheCameraSamplesTracedPerPixelCalibrationIncluded) 
 // ---- the command line --------------------------------------------------------------------------
 
 // Soft shadows and antialiasing; renders in milliseconds.
-constexpr const char* kScene = R"(<?xml version="1.0"?>
+constexpr const char* kGoalScene = R"(<?xml version="1.0"?>
 <Scene>
   <Image Width="24" Height="16"/>
   <Render Samples="4" ShadowRays="1" Seed="3"/>
@@ -244,7 +244,7 @@ class GoalCli : public test::TempFolderTest {
   protected:
     void SetUp() override {
         TempFolderTest::SetUp();
-        test::write_bytes(dir_ / "scene.xml", kScene);
+        test::write_bytes(dir_ / "scene.xml", kGoalScene);
     }
     Outcome run(const std::vector<std::string>& args) const { return run_drt(args, dir_); }
     std::string bytes(const std::string& name) const { return read_bytes(dir_ / name); }
@@ -304,7 +304,7 @@ TEST_F(GoalCli, SppIsTheMaximumOfAllRoundsTogether) {
 }
 
 TEST(RenderToGoal, TheImageIsTheRoundsWeightedByTheirInverseEstimatedVariance) {
-    LoadedScene loaded = load_scene_from_string(kScene, "scene.xml");
+    LoadedScene loaded = load_scene_from_string(kGoalScene, "scene.xml");
     Scene& scene = loaded.scene;
     RenderGoal goal;
     goal.target_error = 1e-9;
@@ -475,7 +475,7 @@ TEST(PlanTopUp, CalibratesTheOtherPixelsAtRandomMostOftenNextToTheirVariance) {
 }
 
 TEST(RenderToGoal, ATopUpIsWeightedByTheRatioOfTheMeanVariancesOverItsPixels) {
-    LoadedScene loaded = load_scene_from_string(kScene, "scene.xml");
+    LoadedScene loaded = load_scene_from_string(kGoalScene, "scene.xml");
     Scene& scene = loaded.scene;
     scene.settings.width = 32;
     scene.settings.height = 24;
@@ -737,9 +737,9 @@ TEST(Predict, AfterAPilotOfSomePixelsAimsAt95PercentAlongMinusFourFifthsUp) {
     EXPECT_EQ(total_samples({pilot}), 0);
 }
 
-// kScene at 128 x 128: a pilot of one pixel in 4 x 4.
+// kGoalScene at 128 x 128: a pilot of one pixel in 4 x 4.
 LoadedScene pilot_scene() {
-    LoadedScene loaded = load_scene_from_string(kScene, "scene.xml");
+    LoadedScene loaded = load_scene_from_string(kGoalScene, "scene.xml");
     loaded.scene.settings.width = 128;
     loaded.scene.settings.height = 128;
     return loaded;

@@ -13,39 +13,26 @@
 #include <string>
 #include <vector>
 
+#include "encoded_bytes.h"
+#include "temp_folder.h"
+
 namespace drt {
 namespace {
 
+using testing::be32;
+using testing::le32;
+
 namespace fs = std::filesystem;
 
-// A fresh folder per test, removed afterwards.
-class ImageFileTest : public ::testing::Test {
-  protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() /
-               ("drt_image_test_" + std::to_string(getpid()) + "_" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
+using test::read_bytes, test::write_bytes;
 
+class ImageFileTest : public test::TempFolderTest {
+  protected:
     fs::path file(const std::string& name) const { return dir_ / name; }
     std::vector<fs::path> entries() const {
         return {fs::directory_iterator(dir_), fs::directory_iterator()};
     }
-
-    fs::path dir_;
 };
-
-std::string read_bytes(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-void write_bytes(const fs::path& path, const std::string& bytes) {
-    std::ofstream(path, std::ios::binary) << bytes;
-}
 
 // A small image with distinct, awkward values: above 1, negative, tiny, and a different top row.
 Image test_pattern(int w = 5, int h = 3) {
@@ -57,14 +44,6 @@ Image test_pattern(int w = 5, int h = 3) {
     }
     image.set(0, 0, {1e-7, 1e30, -7.125});
     return image;
-}
-
-std::uint32_t le32(const std::string& s, std::size_t offset) {
-    std::uint32_t v = 0;
-    for (int k = 0; k < 4; ++k) {
-        v |= std::uint32_t{static_cast<unsigned char>(s[offset + k])} << (8 * k);
-    }
-    return v;
 }
 
 TEST(FormatForPath, KnowsTheFourExtensionsInAnyCase) {
@@ -197,12 +176,6 @@ TEST_F(ImageFileTest, PngAndBmpStoreSrgbEncodedBytes) {
             ASSERT_NEAR(back.rgb[i], expected, 1e-7) << "value " << i;
         }
     }
-}
-
-std::uint32_t be32(const std::string& s, std::size_t offset) {
-    std::uint32_t v = 0;
-    for (int k = 0; k < 4; ++k) v = (v << 8) | static_cast<unsigned char>(s[offset + k]);
-    return v;
 }
 
 TEST_F(ImageFileTest, PngHeader) {

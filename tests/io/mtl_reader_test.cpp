@@ -9,20 +9,20 @@
 namespace drt {
 namespace {
 
-std::vector<MtlMaterial> parse(std::string_view text) {
+std::vector<MtlMaterial> mtl_of(std::string_view text) {
     return parse_mtl(text, "m.mtl");
 }
 
-std::string error_of(std::string_view text) {
+std::string mtl_error(std::string_view text) {
     try {
-        parse(text);
+        mtl_of(text);
     } catch (const MtlError& e) {
         return e.what();
     }
     return "parsed";
 }
 
-void expect_color(const std::optional<Color>& c, double r, double g, double b) {
+void expect_present_color(const std::optional<Color>& c, double r, double g, double b) {
     ASSERT_TRUE(c.has_value());
     EXPECT_DOUBLE_EQ(c->r, r);
     EXPECT_DOUBLE_EQ(c->g, g);
@@ -30,7 +30,7 @@ void expect_color(const std::optional<Color>& c, double r, double g, double b) {
 }
 
 TEST(MtlReader, ReadsTheStatementsOfEachMaterial) {
-    const auto m = parse(
+    const auto m = mtl_of(
         "Kd 9 9 9\n"  // before any newmtl: ignored
         "# comment\n"
         "newmtl red paint\n"
@@ -51,9 +51,9 @@ TEST(MtlReader, ReadsTheStatementsOfEachMaterial) {
     ASSERT_EQ(m.size(), 2u);
     EXPECT_EQ(m[0].name, "red paint");
     EXPECT_EQ(m[0].line, 3);
-    expect_color(m[0].kd, 0.9, 0.1, 0.2);
-    expect_color(m[0].ks, 0.5, 0.5, 0.5);
-    expect_color(m[0].ke, 1, 2, 3);
+    expect_present_color(m[0].kd, 0.9, 0.1, 0.2);
+    expect_present_color(m[0].ks, 0.5, 0.5, 0.5);
+    expect_present_color(m[0].ke, 1, 2, 3);
     EXPECT_EQ(m[0].ns, 100);
     EXPECT_EQ(m[0].ni, 1.33);
     EXPECT_EQ(m[0].dissolve, 0.75);
@@ -75,23 +75,24 @@ TEST(MtlReader, ReadsTheStatementsOfEachMaterial) {
 }
 
 TEST(MtlReader, TheLaterOfDAndTrCounts) {
-    EXPECT_EQ(parse("newmtl a\nd 0.2\nTr 0.1\n")[0].dissolve, 0.9);
-    EXPECT_EQ(parse("newmtl a\nTr 0.1\nd 0.2\n")[0].dissolve, 0.2);
+    EXPECT_EQ(mtl_of("newmtl a\nd 0.2\nTr 0.1\n")[0].dissolve, 0.9);
+    EXPECT_EQ(mtl_of("newmtl a\nTr 0.1\nd 0.2\n")[0].dissolve, 0.2);
 }
 
 TEST(MtlReader, AMalformedNumberIsAnErrorAtItsLine) {
-    EXPECT_EQ(error_of("newmtl a\n\nKd 0.5 abc 1\n"), "m.mtl:3: Kd: \"abc\" is not a number");
-    EXPECT_EQ(error_of("newmtl a\nKd 0.5 0.5\n"), "m.mtl:2: Kd: 1 or 3 values needed, got 2");
-    EXPECT_EQ(error_of("newmtl a\nKs\n"), "m.mtl:2: Ks: a colour needed");
-    EXPECT_EQ(error_of("newmtl a\nNs\n"), "m.mtl:2: Ns: a number needed");
-    EXPECT_EQ(error_of("newmtl a\nNs 1e999\n"), "m.mtl:2: Ns: \"1e999\" is not a finite number");
-    EXPECT_EQ(error_of("newmtl a\nd nan\n"), "m.mtl:2: d: \"nan\" is not a finite number");
-    EXPECT_EQ(error_of("newmtl a\r\nNi 1.5x\r\n"), "m.mtl:2: Ni: \"1.5x\" is not a number");
-    EXPECT_EQ(error_of("newmtl a\nillum 2.5\n"),
+    EXPECT_EQ(mtl_error("newmtl a\n\nKd 0.5 abc 1\n"), "m.mtl:3: Kd: \"abc\" is not a number");
+    EXPECT_EQ(mtl_error("newmtl a\nKd 0.5 0.5\n"), "m.mtl:2: Kd: 1 or 3 values needed, got 2");
+    EXPECT_EQ(mtl_error("newmtl a\nKs\n"), "m.mtl:2: Ks: a colour needed");
+    EXPECT_EQ(mtl_error("newmtl a\nNs\n"), "m.mtl:2: Ns: a number needed");
+    EXPECT_EQ(mtl_error("newmtl a\nNs 1e999\n"), "m.mtl:2: Ns: \"1e999\" is not a finite number");
+    EXPECT_EQ(mtl_error("newmtl a\nd nan\n"), "m.mtl:2: d: \"nan\" is not a finite number");
+    EXPECT_EQ(mtl_error("newmtl a\r\nNi 1.5x\r\n"), "m.mtl:2: Ni: \"1.5x\" is not a number");
+    EXPECT_EQ(mtl_error("newmtl a\nillum 2.5\n"),
               "m.mtl:2: illum: \"2.5\" is not a model from 0 to 10");
-    EXPECT_EQ(error_of("newmtl a\nmap_Kd -bm x f.png\n"), "m.mtl:2: map_Kd: \"x\" is not a number");
-    EXPECT_EQ(error_of("newmtl a\nmap_Kd -s 1 1 1\n"), "m.mtl:2: map_Kd: a file name needed");
-    EXPECT_EQ(error_of("newmtl a\nKd 1 1 1 1\n"), "m.mtl:2: Kd: more than 3 values");
+    EXPECT_EQ(mtl_error("newmtl a\nmap_Kd -bm x f.png\n"),
+              "m.mtl:2: map_Kd: \"x\" is not a number");
+    EXPECT_EQ(mtl_error("newmtl a\nmap_Kd -s 1 1 1\n"), "m.mtl:2: map_Kd: a file name needed");
+    EXPECT_EQ(mtl_error("newmtl a\nKd 1 1 1 1\n"), "m.mtl:2: Kd: more than 3 values");
 }
 
 }  // namespace

@@ -16,14 +16,14 @@ namespace {
 using Indices = std::vector<std::uint32_t>;
 constexpr std::uint32_t kNone = ObjMesh::kNoNormal;
 
-ObjMesh parse(std::string_view text) {
+ObjMesh obj_of(std::string_view text) {
     return parse_obj(text, "m.obj");
 }
 
 // The message a file fails with, or "parsed".
-std::string error_of(std::string_view text) {
+std::string obj_error(std::string_view text) {
     try {
-        parse(text);
+        obj_of(text);
     } catch (const ObjError& e) {
         return e.what();
     }
@@ -37,7 +37,7 @@ constexpr std::string_view kSquare =
     "v 0 1 0\n";
 
 TEST(ObjReader, ReadsPositionsAndNormals) {
-    const ObjMesh m = parse("# a comment\nv 1 -2.5 3e2\nv +4 5 6 1\nvn 0 0 1\nv .5 -0 7\n");
+    const ObjMesh m = obj_of("# a comment\nv 1 -2.5 3e2\nv +4 5 6 1\nvn 0 0 1\nv .5 -0 7\n");
     ASSERT_EQ(m.positions.size(), 3u);
     EXPECT_EQ(m.positions[0], (Vec3{1, -2.5, 300}));
     EXPECT_EQ(m.positions[1], (Vec3{4, 5, 6}));  // the optional weight is read and dropped
@@ -48,24 +48,24 @@ TEST(ObjReader, ReadsPositionsAndNormals) {
 }
 
 TEST(ObjReader, SplitsAPolygonIntoAFan) {
-    const ObjMesh m = parse(std::string(kSquare) + "v 0.5 2 0\nf 1 2 3 5 4\n");
+    const ObjMesh m = obj_of(std::string(kSquare) + "v 0.5 2 0\nf 1 2 3 5 4\n");
     EXPECT_EQ(m.position_indices, (Indices{0, 1, 2, 0, 2, 4, 0, 4, 3}));
     EXPECT_EQ(m.normal_indices, Indices(9, kNone));
 }
 
 TEST(ObjReader, ReadsEveryCornerForm) {
-    const ObjMesh m = parse(std::string(kSquare) +
-                            "vt 0 0\nvt 1 0\nvn 0 0 1\nvn 0 0 -1\n"
-                            "f 1/1 2/2 3/1\n"
-                            "f 1//2 3//1 4//2\n"
-                            "f 2/1/1 3/2/2 4/1/1\n"
-                            "f 1 2/2 3//2\n");
+    const ObjMesh m = obj_of(std::string(kSquare) +
+                             "vt 0 0\nvt 1 0\nvn 0 0 1\nvn 0 0 -1\n"
+                             "f 1/1 2/2 3/1\n"
+                             "f 1//2 3//1 4//2\n"
+                             "f 2/1/1 3/2/2 4/1/1\n"
+                             "f 1 2/2 3//2\n");
     EXPECT_EQ(m.position_indices, (Indices{0, 1, 2, 0, 2, 3, 1, 2, 3, 0, 1, 2}));
     EXPECT_EQ(m.normal_indices, (Indices{kNone, kNone, kNone, 1, 0, 1, 0, 1, 0, kNone, kNone, 1}));
 }
 
 TEST(ObjReader, NegativeIndicesCountBackFromTheLatest) {
-    const ObjMesh m = parse(
+    const ObjMesh m = obj_of(
         "v 0 0 0\nv 1 0 0\nvn 1 0 0\nv 0 1 0\nf -3 -2 -1//-1\nv 5 5 5\n"
         "f -4 -1 2\n");
     EXPECT_EQ(m.position_indices, (Indices{0, 1, 2, 0, 3, 1}));
@@ -73,7 +73,7 @@ TEST(ObjReader, NegativeIndicesCountBackFromTheLatest) {
 }
 
 TEST(ObjReader, IgnoresOtherStatementsAndLineEndings) {
-    const ObjMesh m = parse(
+    const ObjMesh m = obj_of(
         "mtllib x.mtl\r\no thing\r\ng group\r\ns 1\r\nusemtl red\r\nv 0 0 0\r\nv 1 0 0\r\n"
         "v 0 1 0 # trailing comment\r\n\r\n   \r\nl 1 2\r\nf 1 2 3\r\nvp 0.5\r\n"
         "\tf\t1 3 2");  // no newline at the end
@@ -81,52 +81,53 @@ TEST(ObjReader, IgnoresOtherStatementsAndLineEndings) {
 }
 
 TEST(ObjReader, RejectsCoordinatesThatAreNotFiniteNumbers) {
-    EXPECT_EQ(error_of("v 0 0 0\nv 0 abc 0\n"), "m.obj:2: v: \"abc\" is not a number");
-    EXPECT_EQ(error_of("v 0 0.5x 0\n"), "m.obj:1: v: \"0.5x\" is not a number");
-    EXPECT_EQ(error_of("v 0 +-1 0\n"), "m.obj:1: v: \"+-1\" is not a number");
-    EXPECT_EQ(error_of("\n\nv 0 nan 0\n"), "m.obj:3: v: \"nan\" is not a finite number");
-    EXPECT_EQ(error_of("v -inf 0 0\n"), "m.obj:1: v: \"-inf\" is not a finite number");
-    EXPECT_EQ(error_of("v 1e999 0 0\n"), "m.obj:1: v: \"1e999\" is out of range");
-    EXPECT_EQ(error_of("vn 0 0 NaN\n"), "m.obj:1: vn: \"NaN\" is not a finite number");
-    EXPECT_EQ(error_of("v 0 0 0 red\n"), "m.obj:1: v: \"red\" is not a number");
-    EXPECT_EQ(error_of("v 0 1\n"), "m.obj:1: v: 3 coordinates needed, got 2");
+    EXPECT_EQ(obj_error("v 0 0 0\nv 0 abc 0\n"), "m.obj:2: v: \"abc\" is not a number");
+    EXPECT_EQ(obj_error("v 0 0.5x 0\n"), "m.obj:1: v: \"0.5x\" is not a number");
+    EXPECT_EQ(obj_error("v 0 +-1 0\n"), "m.obj:1: v: \"+-1\" is not a number");
+    EXPECT_EQ(obj_error("\n\nv 0 nan 0\n"), "m.obj:3: v: \"nan\" is not a finite number");
+    EXPECT_EQ(obj_error("v -inf 0 0\n"), "m.obj:1: v: \"-inf\" is not a finite number");
+    EXPECT_EQ(obj_error("v 1e999 0 0\n"), "m.obj:1: v: \"1e999\" is out of range");
+    EXPECT_EQ(obj_error("vn 0 0 NaN\n"), "m.obj:1: vn: \"NaN\" is not a finite number");
+    EXPECT_EQ(obj_error("v 0 0 0 red\n"), "m.obj:1: v: \"red\" is not a number");
+    EXPECT_EQ(obj_error("v 0 1\n"), "m.obj:1: v: 3 coordinates needed, got 2");
     // What the file holds is shown safely: control characters escaped, a long value cut.
-    EXPECT_EQ(error_of("v 0 \x1b[2J 0\n"), "m.obj:1: v: \"\\x1b[2J\" is not a number");
-    EXPECT_EQ(error_of("v 0 " + std::string(400, '7') + "x 0\n"),
+    EXPECT_EQ(obj_error("v 0 \x1b[2J 0\n"), "m.obj:1: v: \"\\x1b[2J\" is not a number");
+    EXPECT_EQ(obj_error("v 0 " + std::string(400, '7') + "x 0\n"),
               "m.obj:1: v: \"77777777777777777777... (401 characters)\" is not a number");
-    EXPECT_EQ(error_of("vn 0 1 0 1\n"), "m.obj:1: vn: more than 3 coordinates: \"1\"");
+    EXPECT_EQ(obj_error("vn 0 1 0 1\n"), "m.obj:1: vn: more than 3 coordinates: \"1\"");
 }
 
 TEST(ObjReader, RejectsIndicesOutOfRange) {
     const std::string v(kSquare);
-    EXPECT_EQ(error_of(v + "f 0 1 2\n"), "m.obj:5: f: vertex index 0 in \"0\"; indices start at 1");
-    EXPECT_EQ(error_of(v + "f 1 2 5\n"),
+    EXPECT_EQ(obj_error(v + "f 0 1 2\n"),
+              "m.obj:5: f: vertex index 0 in \"0\"; indices start at 1");
+    EXPECT_EQ(obj_error(v + "f 1 2 5\n"),
               "m.obj:5: f: vertex index 5 is out of range; 4 defined above");
-    EXPECT_EQ(error_of(v + "f 1 2 -5\n"),
+    EXPECT_EQ(obj_error(v + "f 1 2 -5\n"),
               "m.obj:5: f: vertex index -5 is out of range; 4 defined above");
-    EXPECT_EQ(error_of(v + "f 1 2 99999999999999999999\n"),
+    EXPECT_EQ(obj_error(v + "f 1 2 99999999999999999999\n"),
               "m.obj:5: f: vertex index 99999999999999999999 is out of range; 4 defined above");
     // A vertex defined after the face does not count.
-    EXPECT_EQ(error_of("v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\n"),
+    EXPECT_EQ(obj_error("v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\n"),
               "m.obj:3: f: vertex index 3 is out of range; 2 defined above");
-    EXPECT_EQ(error_of(v + "vn 0 0 1\nf 1//1 2//2 3//1\n"),
+    EXPECT_EQ(obj_error(v + "vn 0 0 1\nf 1//1 2//2 3//1\n"),
               "m.obj:6: f: normal index 2 is out of range; 1 defined above");
-    EXPECT_EQ(error_of(v + "vn 0 0 1\nf 1//1 2//0 3//1\n"),
+    EXPECT_EQ(obj_error(v + "vn 0 0 1\nf 1//1 2//0 3//1\n"),
               "m.obj:6: f: normal index 0 in \"2//0\"; indices start at 1");
-    EXPECT_EQ(error_of(v + "vt 0 0\nf 1/1 2/2 3/1\n"),
+    EXPECT_EQ(obj_error(v + "vt 0 0\nf 1/1 2/2 3/1\n"),
               "m.obj:6: f: texture index 2 is out of range; 1 defined above");
 }
 
 TEST(ObjReader, RejectsMalformedFaces) {
     const std::string v(kSquare);
-    EXPECT_EQ(error_of(v + "f 1 2\n"), "m.obj:5: f: a face needs at least 3 vertices, got 2");
-    EXPECT_EQ(error_of(v + "f\n"), "m.obj:5: f: a face needs at least 3 vertices, got 0");
-    EXPECT_EQ(error_of(v + "f 1 2 3x\n"), "m.obj:5: f: \"3x\" is not a vertex reference");
-    EXPECT_EQ(error_of(v + "f 1 2 3/\n"), "m.obj:5: f: \"3/\" is not a vertex reference");
-    EXPECT_EQ(error_of(v + "f 1 2 /3\n"), "m.obj:5: f: \"/3\" is not a vertex reference");
-    EXPECT_EQ(error_of(v + "vn 0 0 1\nf 1 2 3//\n"),
+    EXPECT_EQ(obj_error(v + "f 1 2\n"), "m.obj:5: f: a face needs at least 3 vertices, got 2");
+    EXPECT_EQ(obj_error(v + "f\n"), "m.obj:5: f: a face needs at least 3 vertices, got 0");
+    EXPECT_EQ(obj_error(v + "f 1 2 3x\n"), "m.obj:5: f: \"3x\" is not a vertex reference");
+    EXPECT_EQ(obj_error(v + "f 1 2 3/\n"), "m.obj:5: f: \"3/\" is not a vertex reference");
+    EXPECT_EQ(obj_error(v + "f 1 2 /3\n"), "m.obj:5: f: \"/3\" is not a vertex reference");
+    EXPECT_EQ(obj_error(v + "vn 0 0 1\nf 1 2 3//\n"),
               "m.obj:6: f: \"3//\" is not a vertex reference");
-    EXPECT_EQ(error_of(v + "vn 0 0 1\nf 1 2 3//1/1\n"),
+    EXPECT_EQ(obj_error(v + "vn 0 0 1\nf 1 2 3//1/1\n"),
               "m.obj:6: f: \"3//1/1\" is not a vertex reference");
 }
 

@@ -7,15 +7,13 @@
 #include <string>
 #include <vector>
 
+#include "encoded_bytes.h"
+
 namespace drt {
 namespace {
 
-using Bytes = std::vector<unsigned char>;
-
-void append(void* context, void* data, int size) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    static_cast<Bytes*>(context)->insert(static_cast<Bytes*>(context)->end(), p, p + size);
-}
+using testing::append;
+using testing::Bytes;
 
 // stb's 3 x 2 RGB PNG: signature, IHDR (bytes 8-32), IDAT from byte 33, IEND (the last 12).
 Bytes small_png() {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "drt/io/exr.h"
+#include "encoded_bytes.h"
 
 // Part of libstb's stb_image_write, which its header declares only inside the implementation.
 extern "C" unsigned char* stbi_zlib_compress(unsigned char* data, int data_len, int* out_len,
@@ -18,12 +19,8 @@ extern "C" unsigned char* stbi_zlib_compress(unsigned char* data, int data_len, 
 namespace drt {
 namespace {
 
-using Bytes = std::vector<unsigned char>;
-
-void append(void* context, void* data, int size) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    static_cast<Bytes*>(context)->insert(static_cast<Bytes*>(context)->end(), p, p + size);
-}
+using testing::append;
+using testing::Bytes;
 
 // A 2 x 1 RGB image, pixel 0 = (a, b, c), pixel 1 = (c, b, a), in the format `kind`.
 Bytes encoded(const std::string& kind, unsigned char a, unsigned char b, unsigned char c) {

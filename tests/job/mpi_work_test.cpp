@@ -59,11 +59,11 @@ TEST(BoundByMpirunDefault, OnlyMpirunsOwnBindingIsUndone) {
     EXPECT_FALSE(with({{"OMPI_MCA_orte_bound_at_launch", "0"}}));
 }
 
-const fs::path kSource = DRT_SOURCE_DIR;
+const fs::path kSourceDir = DRT_SOURCE_DIR;
 // Motion blur, depth of field, glossy reflection, soft shadows.
-const std::string kMotion = (kSource / "scenes/thesis/test5.xml").string();
+const std::string kMotion = (kSourceDir / "scenes/thesis/test5.xml").string();
 // Glossy reflection and refraction, depth of field, soft shadows.
-const std::string kGlossy = (kSource / "scenes/thesis/test6.xml").string();
+const std::string kGlossy = (kSourceDir / "scenes/thesis/test6.xml").string();
 
 using MpiModule = TempFolderTest;
 
@@ -198,7 +198,7 @@ TEST_P(MpiProcessesAndThreads, AdaptiveRenderIsTheSingleProcesssBitsAndRayCounts
 
 // A path render's tile messages carry their diffuse ray counts to the leader.
 TEST_F(MpiCli, PathRenderIsTheSingleProcesssBitsAndDiffuseRays) {
-    const std::string cornell = (kSource / "scenes/gi/cornell-box.xml").string();
+    const std::string cornell = (kSourceDir / "scenes/gi/cornell-box.xml").string();
     const std::vector<std::string> options{"--spp", "4", "-q"};
     std::vector<std::string> plain = small(cornell, "plain.pfm", options);
     plain.insert(plain.end(), {"--stats", "plain.json"});
@@ -216,7 +216,7 @@ TEST_F(MpiCli, PathRenderIsTheSingleProcesssBitsAndDiffuseRays) {
 // Photon maps are functions of (seed, pass) alone, built by every process for itself: the caustic
 // is the single process's to the bit, and every process counts the photons it traced once.
 TEST_F(MpiCli, CausticRenderIsTheSingleProcesssBitsAndPhotons) {
-    const std::string caustic = (kSource / "scenes/caustics/test1-caustic.xml").string();
+    const std::string caustic = (kSourceDir / "scenes/caustics/test1-caustic.xml").string();
     const std::vector<std::string> options{"--spp", "4", "-q"};
     std::vector<std::string> plain = small(caustic, "plain.pfm", options);
     plain.insert(plain.end(), {"--stats", "plain.json"});
@@ -423,7 +423,7 @@ TEST_F(MpiCli, AKilledProcessLeavesNoOutputAndTheRerunCompletesTheSameBits) {
 TEST_F(MpiCli, AWorkerStoppedOnItsOwnGivesBackTheTileInHandAndTheLeaderFinishesTheSameBits) {
     // Path tracing at 256 spp: a tile takes about a second, so the signal finds the worker
     // inside one, which it abandons between two pixels and gives back with those it holds.
-    const std::string cornell = (kSource / "scenes/gi/cornell-box.xml").string();
+    const std::string cornell = (kSourceDir / "scenes/gi/cornell-box.xml").string();
     const std::vector<std::string> more{"--spp", "256", "--threads", "1"};
     ASSERT_EQ(run(small(cornell, "plain.pfm", more)).status, 0);
     std::vector<std::string> args = small(cornell, "out.pfm", more);

@@ -19,18 +19,14 @@
 
 #include "drt/render/renderer.h"
 #include "drt/shading/texture.h"
+#include "test_render.h"
 #include "test_scenes.h"
 
 namespace drt {
 namespace {
 
 using testing::add_material;
-
-RenderResult render_with(const Scene& scene) {
-    RenderOptions options;
-    options.threads = 2;
-    return render(scene, options);
-}
+using testing::render_with;
 
 // Where a floor pixel's camera ray lands (the floor is y = 0).
 Vec3 on_floor(const Camera& camera, Vec2 film) {

@@ -12,27 +12,15 @@
 #include "drt/render/renderer.h"
 #include "drt/scene/environment.h"
 #include "drt/scene/scene_loader.h"
+#include "test_render.h"
 
 namespace drt {
 namespace {
 
-Scene from_xml(const std::string& xml) {
-    return load_scene_from_string(xml, "test.xml").scene;
-}
-
-RenderResult render_with(const Scene& scene) {
-    RenderOptions options;
-    options.threads = 2;
-    return render(scene, options);
-}
-
-Color image_mean(const Image& image) {
-    Color sum;
-    for (int y = 0; y < image.height; ++y) {
-        for (int x = 0; x < image.width; ++x) sum += image.at(x, y);
-    }
-    return sum / (double(image.width) * image.height);
-}
+using testing::expect_relative;
+using testing::from_xml;
+using testing::image_mean;
+using testing::render_with;
 
 std::shared_ptr<const Environment> uniform_environment(Color radiance, double intensity = 1) {
     Image image(16, 8);
@@ -54,13 +42,6 @@ std::shared_ptr<const Environment> sun_environment(Environment::Sampling samplin
     }
     return std::make_shared<const Environment>(std::make_shared<const MipMap>(image), 1, 0,
                                                sampling);
-}
-
-void expect_relative(const Color& got, const Color& expected, double tolerance,
-                     const std::string& what) {
-    EXPECT_NEAR(got.r, expected.r, tolerance * expected.r) << what;
-    EXPECT_NEAR(got.g, expected.g, tolerance * expected.g) << what;
-    EXPECT_NEAR(got.b, expected.b, tolerance * expected.b) << what;
 }
 
 // Rays that miss everything see the environment, not Background, in both integrators.
@@ -150,7 +131,7 @@ TEST(EnvironmentRender, ShadowRaysAreSharedWithTheLightsByPower) {
     EXPECT_TRUE(plan.effects.soft_shadows);
 }
 
-double rmse(const Image& a, const Image& b) {
+double image_rmse(const Image& a, const Image& b) {
     double sum = 0;
     for (int y = 0; y < a.height; ++y) {
         for (int x = 0; x < a.width; ++x) {
@@ -178,9 +159,9 @@ TEST(EnvironmentRender, ImportanceSamplingIsLessNoisyThanUniformSampling) {
     };
     const Image reference = render_with(scene(4096, Environment::Sampling::kLuminance)).image;
     const double importance =
-        rmse(render_with(scene(16, Environment::Sampling::kLuminance)).image, reference);
+        image_rmse(render_with(scene(16, Environment::Sampling::kLuminance)).image, reference);
     const double uniform =
-        rmse(render_with(scene(16, Environment::Sampling::kUniform)).image, reference);
+        image_rmse(render_with(scene(16, Environment::Sampling::kUniform)).image, reference);
     EXPECT_GT(importance, 0);
     EXPECT_LT(importance * 8, uniform) << importance << " " << uniform;
 }

@@ -17,6 +17,7 @@
 #include "drt/render/render_plan.h"
 #include "drt/render/renderer.h"
 #include "drt/sampling/sampler.h"
+#include "test_render.h"
 #include "test_scenes.h"
 
 namespace drt {
@@ -24,12 +25,7 @@ namespace {
 
 using testing::floor_scene;
 using testing::lone_sphere_scene;
-
-RenderResult render_with(const Scene& scene, int threads = 2) {
-    RenderOptions options;
-    options.threads = threads;
-    return render(scene, options);
-}
+using testing::render_with;
 
 TEST(Integrator, GreyFloorUnderPointLightIsLambertExactly) {
     Scene scene = floor_scene(24, 16);

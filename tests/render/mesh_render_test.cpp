@@ -22,7 +22,7 @@ namespace {
 
 using testing::add_material;
 
-Image render_with(const Scene& scene, int threads = 2) {
+Image rendered_image(const Scene& scene, int threads = 2) {
     RenderOptions options;
     options.threads = threads;
     return render(scene, options).image;
@@ -89,16 +89,16 @@ Scene ball_scene(const Material& material, int levels, const Vec3& offset = {}) 
 // facets are visible, is off by 4e-3 on average and in 2 % of the pixels, and fails them.
 TEST(MeshRender, AFineIcosphereRendersLikeTheSphere) {
     const Material diffuse = testing::grey_lambert();
-    const Difference d =
-        difference(render_with(ball_scene(diffuse, kSphere)), render_with(ball_scene(diffuse, 5)));
+    const Difference d = difference(rendered_image(ball_scene(diffuse, kSphere)),
+                                    rendered_image(ball_scene(diffuse, 5)));
     EXPECT_LT(d.mean, 5e-4);
     EXPECT_LT(d.large, 0.002);
 }
 
 TEST(MeshRender, AFineGlassIcosphereRefractsLikeTheGlassSphere) {
     const Material glass = testing::glass(1.5);
-    const Difference d =
-        difference(render_with(ball_scene(glass, kSphere)), render_with(ball_scene(glass, 5)));
+    const Difference d = difference(rendered_image(ball_scene(glass, kSphere)),
+                                    rendered_image(ball_scene(glass, 5)));
     EXPECT_LT(d.mean, 5e-4);
     EXPECT_LT(d.large, 0.002);
 }
@@ -106,8 +106,8 @@ TEST(MeshRender, AFineGlassIcosphereRefractsLikeTheGlassSphere) {
 TEST(MeshRender, FarFromTheOriginAnIcosphereRendersLikeTheSphere) {
     const Material diffuse = testing::grey_lambert();
     const Vec3 far{1e5, -1e5, 1e5};
-    const Difference d = difference(render_with(ball_scene(diffuse, kSphere, far)),
-                                    render_with(ball_scene(diffuse, 5, far)));
+    const Difference d = difference(rendered_image(ball_scene(diffuse, kSphere, far)),
+                                    rendered_image(ball_scene(diffuse, 5, far)));
     EXPECT_LT(d.mean, 5e-4);
     EXPECT_LT(d.large, 0.002);
 }
@@ -134,8 +134,8 @@ Scene floor_scene(bool triangles, const Vec3& offset) {
 
 TEST(MeshRender, TwoTrianglesFormingASquareMatchThePlane) {
     for (const Vec3& offset : {Vec3{}, Vec3{1e5, 1e5, -1e5}}) {
-        const Image plane = render_with(floor_scene(false, offset));
-        const Image square = render_with(floor_scene(true, offset));
+        const Image plane = rendered_image(floor_scene(false, offset));
+        const Image square = rendered_image(floor_scene(true, offset));
         const Difference d = difference(plane, square);
         EXPECT_LT(d.max, 1e-6) << "offset " << offset.x;
         double lit = 0;
@@ -147,8 +147,8 @@ TEST(MeshRender, TwoTrianglesFormingASquareMatchThePlane) {
 TEST(MeshRender, ImagesDoNotDependOnTheThreadCount) {
     Scene scene = ball_scene(testing::glass(1.5, 300), 3);
     scene.settings.samples = 9;
-    const Image one = render_with(scene, 1);
-    const Image three = render_with(scene, 3);
+    const Image one = rendered_image(scene, 1);
+    const Image three = rendered_image(scene, 3);
     EXPECT_EQ(one.rgb, three.rgb);
 }
 
@@ -174,7 +174,7 @@ TEST(MeshRender, ACoarseSmoothIcosphereHasNoBlackFacetsAtTheTerminator) {
         Scene scene = lone_ball(testing::grey_lambert(1.0), levels);
         scene.background = {0, 0, 1};  // told from the grey ball by its red
         scene.lights.push_back(std::make_unique<PointLight>(Vec3{1000, 0, 200}, Color{1, 1, 1}));
-        return render_with(scene);
+        return rendered_image(scene);
     };
     const Image sphere = lit(kSphere), coarse = lit(1);
     // Measured: none of the 422 pixels compared is darker than a quarter of the sphere's value
@@ -240,7 +240,7 @@ TEST(MeshRender, SmoothNormalsNeverSendAMirrorOrRefractedRayToTheWrongSide) {
 // sent into the coarse smooth icosphere would bounce inside it and come out darker or not at all
 // (84 pixels do with the mirror direction about the shading normal alone).
 TEST(MeshRender, ACoarseSmoothMirrorBallReflectsEveryRayAwayFromItself) {
-    const Image image = render_with(lone_ball(testing::mirror({0.8, 0.8, 0.8}), 1));
+    const Image image = rendered_image(lone_ball(testing::mirror({0.8, 0.8, 0.8}), 1));
     int ball = 0, other = 0;
     for (const float v : image.rgb) {
         ball += v == 0.8f;
@@ -281,7 +281,7 @@ TEST(MeshRender, InsideAGlassIcosphereRaysAreTotallyReflectedAsInTheSphere) {
         }
     }
     EXPECT_GT(beyond, size * size / 5);
-    const Difference d = difference(render_with(sphere), render_with(inside(5)));
+    const Difference d = difference(rendered_image(sphere), rendered_image(inside(5)));
     EXPECT_LT(d.mean, 1e-3);
     EXPECT_LT(d.large, 0.004);
 }
@@ -291,7 +291,7 @@ TEST(MeshRender, InsideAGlassIcosphereRaysAreTotallyReflectedAsInTheSphere) {
 // A ball of radius 3 crossing 30 units from right to left at distance 100 before a pinhole camera
 // whose pixel there is 1 unit, ambient-lit on black (as in the sphere's streak test of
 // effects_test.cpp): an analytic sphere or a fine icosphere moving along the same path.
-Scene streak_scene(int levels) {
+Scene mesh_streak_scene(int levels) {
     constexpr int kWidth = 64, kHeight = 9;
     constexpr double kDepth = 100, kRadius = 3, kPath = 30;
     Scene scene = testing::blank_scene(kWidth, kHeight, 64);
@@ -328,8 +328,8 @@ Streak streak_of(const Image& image) {
 // another pace than the sphere fails them: a mesh moved 2 % too slowly shifts the centroid by
 // 0.2 pixel and the streak's first pixel by one.
 TEST(MeshRender, AMovingMeshLeavesTheMovingSpheresStreak) {
-    const Streak sphere = streak_of(render_with(streak_scene(kSphere)));
-    const Streak mesh = streak_of(render_with(streak_scene(4)));
+    const Streak sphere = streak_of(rendered_image(mesh_streak_scene(kSphere)));
+    const Streak mesh = streak_of(rendered_image(mesh_streak_scene(4)));
     EXPECT_EQ(mesh.first, sphere.first);
     EXPECT_EQ(mesh.last, sphere.last);
     EXPECT_NEAR(mesh.centroid, sphere.centroid, 0.1);
@@ -393,7 +393,7 @@ TEST(MeshRender, SliverAndDegenerateTrianglesNeverGiveANonFinitePixel) {
         scene.objects.push_back(std::make_unique<Mesh>(mesh, std::vector<Vec3>{{}}, m));
         scene.lights.push_back(
             std::make_unique<SphereLight>(Vec3{-3, 4, -6}, 1, Color{1, 1, 1}, false));
-        const Image image = render_with(scene);
+        const Image image = rendered_image(scene);
         const auto bad = std::count_if(image.rgb.begin(), image.rgb.end(),
                                        [](float v) { return !std::isfinite(v); });
         EXPECT_EQ(bad, 0) << material.name;
@@ -443,9 +443,9 @@ Scene scaled_mesh_scene(double scale) {
 // and no leak. An offset without its part proportional to |p| (1e-9 alone) is off by 8.6e-4 at
 // 1e7, and by 0.08 at 1e9; docs/design.md has the table.
 TEST(MeshRender, AMeshSceneLooksTheSameAtEveryScale) {
-    const Image reference = render_with(scaled_mesh_scene(1));
+    const Image reference = rendered_image(scaled_mesh_scene(1));
     for (const double scale : {1e-3, 1e3, 1e5, 1e7}) {
-        const Difference d = difference(reference, render_with(scaled_mesh_scene(scale)));
+        const Difference d = difference(reference, rendered_image(scaled_mesh_scene(scale)));
         EXPECT_LT(d.mean, 1e-6) << scale;
         EXPECT_LT(d.max, 1e-4) << scale;
     }

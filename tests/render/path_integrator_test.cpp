@@ -16,28 +16,16 @@
 #include "drt/scene/scene_loader.h"
 #include "test_math.h"
 #include "test_meshes.h"
+#include "test_render.h"
 #include "test_scenes.h"
 
 namespace drt {
 namespace {
 
-RenderResult render_with(const Scene& scene, int threads = 2) {
-    RenderOptions options;
-    options.threads = threads;
-    return render(scene, options);
-}
-
-Scene from_xml(const std::string& xml) {
-    return load_scene_from_string(xml, "test.xml").scene;
-}
-
-Color image_mean(const Image& image) {
-    Color sum;
-    for (int y = 0; y < image.height; ++y) {
-        for (int x = 0; x < image.width; ++x) sum += image.at(x, y);
-    }
-    return sum / (double(image.width) * image.height);
-}
+using testing::expect_relative;
+using testing::from_xml;
+using testing::image_mean;
+using testing::render_with;
 
 // A camera inside a closed sphere of emission Le, diffuse 1, kd rho: every path sees Le at each
 // of its up to MaxDepth + 1 surface points, weighed by rho per scattering event.
@@ -149,13 +137,6 @@ std::string floor_under_sphere(const std::string& integrator, const std::string&
 Color floor_under_sphere_expected() {
     const double factor = 0.9 * 0.25;  // diffuse · (r/h)²
     return {factor * 0.5 * 2, factor * 0.25 * 3, factor * 1 * 4};
-}
-
-void expect_relative(const Color& got, const Color& expected, double tolerance,
-                     const std::string& what) {
-    EXPECT_NEAR(got.r, expected.r, tolerance * expected.r) << what;
-    EXPECT_NEAR(got.g, expected.g, tolerance * expected.g) << what;
-    EXPECT_NEAR(got.b, expected.b, tolerance * expected.b) << what;
 }
 
 TEST(Emitters, EmittingSphereLightsAFloorAsTheClosedFormInBothIntegrators) {

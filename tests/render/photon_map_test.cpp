@@ -13,13 +13,12 @@
 #include "drt/render/path_integrator.h"
 #include "drt/render/renderer.h"
 #include "drt/scene/scene_loader.h"
+#include "test_render.h"
 
 namespace drt {
 namespace {
 
-Scene from_xml(const std::string& xml) {
-    return load_scene_from_string(xml, "test.xml").scene;
-}
+using testing::from_xml;
 
 // --- the model ---
 

@@ -47,7 +47,7 @@ void expect_same_counts(const RayCounts& a, const RayCounts& b) {
 }
 
 // Area lights, glass with blurry refraction, depth of field; and glossy reflection.
-const std::vector<std::string> kScenes = {"thesis/test6.xml", "figures/glossy-n10.xml"};
+const std::vector<std::string> kTestScenes = {"thesis/test6.xml", "figures/glossy-n10.xml"};
 
 TEST(TileGrid, CutsTheImageRowByRowWithSmallerTilesAtTheEdges) {
     const std::vector<Tile> tiles = tile_grid(40, 20);
@@ -72,7 +72,7 @@ TEST(ImageSink, RefusesATileTwiceAndATileOfAnotherGrid) {
 }
 
 TEST(Renderer, TilesInAnyOrderGiveTheWholeRendersBits) {
-    for (const std::string& name : kScenes) {
+    for (const std::string& name : kTestScenes) {
         SCOPED_TRACE(name);
         const Scene scene = small_scene(name, 72);
         const RenderResult whole = render(scene, on_threads(2));
@@ -110,7 +110,7 @@ TEST(Renderer, ThreadsBeyondTheTilesHelpWithTheirPixelsAndChangeNoBit) {
 }
 
 TEST(Renderer, TileBuffersRayCountsSumToTheWholeRenders) {
-    for (const std::string& name : kScenes) {
+    for (const std::string& name : kTestScenes) {
         SCOPED_TRACE(name);
         const Scene scene = small_scene(name, 72);
         const RenderResult whole = render(scene, on_threads(2));

@@ -13,6 +13,7 @@
 #include "drt/render/renderer.h"
 #include "drt/sampling/multi_jittered.h"
 #include "drt/scene/scene_loader.h"
+#include "test_render.h"
 #include "test_scenes.h"
 
 namespace drt {
@@ -21,12 +22,7 @@ namespace {
 using testing::add_material;
 using testing::floor_scene;
 using testing::lone_sphere_scene;
-
-RenderResult render_with(const Scene& scene) {
-    RenderOptions options;
-    options.threads = 2;
-    return render(scene, options);
-}
+using testing::render_with;
 
 // Traces single rays through a scene, outside the renderer, in double precision.
 class Tracer {

@@ -10,13 +10,12 @@
 #include <vector>
 
 #include "drt/util/rng.h"
+#include "test_math.h"
 
 namespace drt {
 namespace {
 
-double uniform(std::uint64_t stream, std::uint64_t i) {
-    return to_unit(hash_of(stream, i));
-}
+using testing::unit;
 
 // Pearson's chi-square statistic of `counts` against `expected` counts.
 double chi_square(const std::vector<double>& counts, const std::vector<double>& expected) {
@@ -38,7 +37,7 @@ TEST(Distribution1D, DensityFollowsTheFunctionAndSamplesMatchIt) {
     constexpr int kSamples = 100000;
     std::vector<double> counts(4, 0);
     for (int i = 0; i < kSamples; ++i) {
-        const auto s = d.sample(uniform(1, i));
+        const auto s = d.sample(unit(1, i));
         ASSERT_GE(s.x, 0.0);
         ASSERT_LT(s.x, 1.0);
         ASSERT_EQ(s.index, static_cast<std::size_t>(s.x * 4));
@@ -66,7 +65,7 @@ TEST(Distribution2D, DensityIntegratesToOneAndSamplesMatchIt) {
     constexpr std::size_t nu = 16, nv = 8;
     std::vector<float> f(nu * nv);
     for (std::size_t k = 0; k < f.size(); ++k) {
-        f[k] = uniform(7, k) < 0.2 ? 0.0f : static_cast<float>(10 * uniform(8, k));
+        f[k] = unit(7, k) < 0.2 ? 0.0f : static_cast<float>(10 * unit(8, k));
     }
     for (std::size_t i = 0; i < nu; ++i) f[3 * nu + i] = 0;  // an empty row
     const Distribution2D d(f, nu, nv);
@@ -84,7 +83,7 @@ TEST(Distribution2D, DensityIntegratesToOneAndSamplesMatchIt) {
     EXPECT_NEAR(total, 1.0, 1e-6);
     std::vector<double> counts(nu * nv, 0);
     for (int k = 0; k < kSamples; ++k) {
-        const auto s = d.sample({uniform(2, k), uniform(3, k)});
+        const auto s = d.sample({unit(2, k), unit(3, k)});
         ASSERT_NEAR(s.pdf, d.pdf(s.uv), 1e-9 * s.pdf);
         ++counts[static_cast<std::size_t>(s.uv.y * nv) * nu +
                  static_cast<std::size_t>(s.uv.x * nu)];

@@ -22,8 +22,8 @@ using testing::uniform_by_ks;
 // Square, rectangular (k = m*n) and ragged counts, the largest grids whose sides are both listed
 // orders (20, 25) and one between them whose rows are dealt (24), and counts past the dealt
 // shuffles (1024) and the small grid sides (64).
-const std::uint32_t kCounts[] = {1,  2,  3,  4,  5,  7,   9,   10,   12,   16,   17,
-                                 20, 24, 25, 64, 82, 100, 256, 1000, 1025, 1500, 4100};
+const std::uint32_t kPatternCounts[] = {1,  2,  3,  4,  5,  7,   9,   10,   12,   16,   17,
+                                        20, 24, 25, 64, 82, 100, 256, 1000, 1025, 1500, 4100};
 
 std::vector<Vec2> run_of(std::uint32_t k, std::uint32_t key) {
     std::vector<Vec2> points(k);
@@ -42,7 +42,7 @@ std::uint32_t key_of(std::uint32_t i) {
 }
 
 TEST(MultiJittered, EveryStratumExactlyOnceForAnyCountAndKey) {
-    for (const std::uint32_t k : kCounts) {
+    for (const std::uint32_t k : kPatternCounts) {
         for (std::uint32_t i = 0; i < (k > 1000 ? 3u : 20u); ++i) {
             EXPECT_TRUE(multi_jittered_strata(run_of(k, key_of(i)))) << "run, k " << k;
             EXPECT_TRUE(multi_jittered_strata(set_of(k, key_of(i)))) << "set, k " << k;

@@ -15,9 +15,7 @@
 namespace drt {
 namespace {
 
-double uniform(std::uint64_t stream, std::uint64_t i) {
-    return to_unit(hash_of(stream, i));
-}
+using testing::unit;
 
 // α + β + γ − π from the angles between the planes of the arcs: an independent area.
 double angle_sum_area(const Vec3& a, const Vec3& b, const Vec3& c) {
@@ -61,7 +59,7 @@ TEST(SphericalTriangle, EveryDirectionIsUnitAndInside) {
     for (const auto& p : triangles()) {
         const SphericalTriangle t = spherical_triangle(p[0], p[1], p[2]);
         for (std::uint64_t i = 0; i < 20000; ++i) {
-            const Vec3 d = sample_spherical_triangle(t, {uniform(1, i), uniform(2, i)});
+            const Vec3 d = sample_spherical_triangle(t, {unit(1, i), unit(2, i)});
             ASSERT_NEAR(length(d), 1, 1e-12);
             ASSERT_TRUE(inside(t, d)) << "area " << t.area << " sample " << i;
         }
@@ -98,7 +96,7 @@ TEST(SphericalTriangle, DirectionsAreUniformInSolidAngle) {
         const int n = 160000;
         std::vector<double> counts(cells.size(), 0);
         for (int i = 0; i < n; ++i) {
-            const Vec3 d = sample_spherical_triangle(t, {uniform(3, i), uniform(4, i)});
+            const Vec3 d = sample_spherical_triangle(t, {unit(3, i), unit(4, i)});
             for (std::size_t k = 0; k < cells.size(); ++k) {
                 if (inside(cells[k], d)) {
                     ++counts[k];

@@ -22,9 +22,7 @@
 namespace drt {
 namespace {
 
-double uniform(std::uint64_t stream, std::uint64_t i) {
-    return to_unit(hash_of(stream, i));
-}
+using testing::unit;
 
 // A quad in the plane y = 1 split into two triangles of unequal area (2.5 and 2.375), both
 // sides emitting radiance 1. Its corners are exact in single precision, as a mesh keeps them.
@@ -108,7 +106,7 @@ TEST(Emitters, SampledDirectionsReachTheMeshWithTheDensityPdfGives) {
     ASSERT_EQ(q->emitters->size(), 1u);
     for (const Vec3& x : kViews) {
         for (std::uint64_t i = 0; i < 4000; ++i) {
-            const auto s = q->emitters->sample(0, x, {uniform(1, i), uniform(2, i)}, 0);
+            const auto s = q->emitters->sample(0, x, {unit(1, i), unit(2, i)}, 0);
             ASSERT_TRUE(s);
             const Vec3 point = x + s->dir * s->distance;
             ASSERT_NEAR(point.y, 1, 1e-9 * (1 + s->distance));
@@ -143,7 +141,7 @@ TEST(Emitters, AnEmittingPartOfASharedMeshSamplesOnlyItsOwnTriangles) {
     if (lamp.mesh().parts()[0] != lamp.part()) std::swap(lamp_triangle, floor_triangle);
     const Vec3 x{0.1, 1, 0.2};
     for (std::uint64_t i = 0; i < 1000; ++i) {
-        const auto s = emitters.sample(0, x, {uniform(3, i), uniform(4, i)}, 0);
+        const auto s = emitters.sample(0, x, {unit(3, i), unit(4, i)}, 0);
         ASSERT_TRUE(s);
         const Vec3 point = x + s->dir * s->distance;
         ASSERT_NEAR(point.y, 2, 1e-9);
@@ -258,7 +256,7 @@ Irradiance estimate(const Emitters& emitters, const Vec3& x, bool by_area, int n
     const auto p = corners(0);
     double sum = 0, sum2 = 0;
     for (int i = 0; i < n; ++i) {
-        const Vec2 u{uniform(5, i), uniform(6, i)};
+        const Vec2 u{unit(5, i), unit(6, i)};
         double value = 0;
         if (by_area) {
             const double su = std::sqrt(u.x);

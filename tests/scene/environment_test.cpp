@@ -14,9 +14,12 @@
 #include "drt/scene/scene_loader.h"
 #include "drt/util/rng.h"
 #include "temp_folder.h"
+#include "test_math.h"
 
 namespace drt {
 namespace {
+
+using testing::unit;
 
 // The direction of (u, v) by the contract: φ = 2πu + rotation, θ = π(1 − v).
 Vec3 direction_of(double u, double v, double rotate_y = 0) {
@@ -37,10 +40,6 @@ std::shared_ptr<const MipMap> uniform_map(int w, int h, Color c) {
         for (int x = 0; x < w; ++x) image.set(x, y, c);
     }
     return std::make_shared<const MipMap>(image);
-}
-
-double uniform(std::uint64_t stream, std::uint64_t i) {
-    return to_unit(hash_of(stream, i));
 }
 
 // The contract's fixed points: the left edge at the horizon is +x, a quarter of the way across
@@ -79,7 +78,7 @@ TEST(Environment, OneBrightTexelAppearsWhereExpectedAndRotateYTurnsIt) {
         // Samples go to the bright texel's neighbourhood (its light spreads half a texel by
         // the bilinear lookup) and nowhere else.
         for (int k = 0; k < 1000; ++k) {
-            const auto s = env.sample({uniform(4, k), uniform(5, k)});
+            const auto s = env.sample({unit(4, k), unit(5, k)});
             ASSERT_TRUE(s);
             EXPECT_GT(dot(s->dir, expected), std::cos(2.5 * kPi / h)) << degrees;
         }
@@ -95,7 +94,7 @@ TEST(Environment, OneBrightTexelAppearsWhereExpectedAndRotateYTurnsIt) {
 TEST(Environment, IntensityScalesTheRadiance) {
     const Environment env(uniform_map(8, 4, {0.5, 1, 2}), 3, 0.7);
     for (int k = 0; k < 20; ++k) {
-        const Vec3 d = direction_of(uniform(6, k), uniform(7, k));
+        const Vec3 d = direction_of(unit(6, k), unit(7, k));
         const Color c = env.radiance(d);
         EXPECT_NEAR(c.r, 1.5, 1e-6);
         EXPECT_NEAR(c.g, 3, 1e-6);
@@ -112,7 +111,7 @@ TEST(Environment, DensityIntegratesToOneAndImportanceSamplingIsUnbiased) {
     for (int y = 0; y < 32; ++y) {
         for (int x = 0; x < 64; ++x) {
             const double l =
-                0.2 + uniform(9, y * 64 + x) + (x > 40 && x < 44 && y > 8 && y < 11 ? 500 : 0);
+                0.2 + unit(9, y * 64 + x) + (x > 40 && x < 44 && y > 8 && y < 11 ? 500 : 0);
             image.set(x, y, {l, 0.5 * l, 0.25 * l});
         }
     }
@@ -135,7 +134,7 @@ TEST(Environment, DensityIntegratesToOneAndImportanceSamplingIsUnbiased) {
         double estimate = 0, square = 0;
         constexpr int kSamples = 800000;
         for (int k = 0; k < kSamples; ++k) {
-            const auto s = env.sample({uniform(stream, k), uniform(stream + 1, k)});
+            const auto s = env.sample({unit(stream, k), unit(stream + 1, k)});
             ASSERT_TRUE(s);
             ASSERT_NEAR(s->pdf, env.pdf(s->dir), 1e-6 * s->pdf);
             const double f = luminance(s->radiance) / s->pdf;

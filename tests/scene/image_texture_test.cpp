@@ -15,22 +15,20 @@
 #include "drt/scene/texture_cache.h"
 #include "run_drt.h"
 #include "temp_folder.h"
+#include "test_scenes.h"
 
 namespace drt {
 namespace {
 
-using test::TempFolderTest;
+using testing::plain_material;
 
-const Material& plain_material() {
-    static const Material material{};
-    return material;
-}
+using test::TempFolderTest;
 
 // Shows what it is looked up with as its colour: (u, v, 0), or with `footprint` the lengths of
 // the two (u, v) steps and 0.
-class RecordingTexture final : public Texture {
+class LookupTexture final : public Texture {
   public:
-    explicit RecordingTexture(bool footprint = false) : footprint_(footprint) {}
+    explicit LookupTexture(bool footprint = false) : footprint_(footprint) {}
     Color value(const TexturePoint& at) const override {
         if (!footprint_) return {at.uv.x, at.uv.y, 0};
         return {std::hypot(at.duv_dx.x, at.duv_dx.y), std::hypot(at.duv_dy.x, at.duv_dy.y), 0};
@@ -54,7 +52,7 @@ std::shared_ptr<const TriangleMesh> one_triangle(const Vec3& a, const Vec3& b, c
 TEST(TriangleUv, CornerCoordinatesAreInterpolated) {
     const Vec3 a{1, 0, 5}, b{4, 1, 5}, c{0, 3, 5};
     SurfaceDetail detail;
-    detail.texture = std::make_shared<const RecordingTexture>();
+    detail.texture = std::make_shared<const LookupTexture>();
     detail.corner_uv = {{{0.1, 0.9}, {0.7, 0.2}, {-1.5, 2.0}}};
     const Mesh mesh(one_triangle(a, b, c), {Vec3{}}, plain_material(), detail);
     const Vec3 p = a + (b - a) * 0.2 + (c - a) * 0.3;
@@ -71,7 +69,7 @@ TEST(TriangleUv, CornerCoordinatesAreInterpolated) {
 TEST(TextureFootprint, CameraRaysSpanOnePixelStepOnTheSurface) {
     const Camera camera = Camera::look_at({{0, 0, 10}, {0, 0, 0}, {0, 1, 0}, 90}, 100, 100, {});
     SurfaceDetail detail;
-    detail.texture = std::make_shared<const RecordingTexture>(true);
+    detail.texture = std::make_shared<const LookupTexture>(true);
     detail.texture_scale = 2;
     const Plane plane({0, 0, 0}, {0, 0, 1}, plain_material(), detail);
     const Ray ray = camera.generate_ray({50, 50}, {0.5, 0.5}, 0);

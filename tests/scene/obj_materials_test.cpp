@@ -11,15 +11,12 @@
 #include "drt/accel/mesh.h"
 #include "drt/scene/scene_loader.h"
 #include "temp_folder.h"
+#include "test_math.h"
 
 namespace drt {
 namespace {
 
-void expect_color(const Color& c, double r, double g, double b) {
-    EXPECT_DOUBLE_EQ(c.r, r);
-    EXPECT_DOUBLE_EQ(c.g, g);
-    EXPECT_DOUBLE_EQ(c.b, b);
-}
+using testing::expect_color;
 
 // --- the MTL -> thesis material mapping ---
 

@@ -15,9 +15,12 @@
 #include "drt/accel/mesh.h"
 #include "drt/geometry/plane.h"
 #include "drt/geometry/sphere.h"
+#include "test_math.h"
 
 namespace drt {
 namespace {
+
+using testing::expect_color;
 
 using namespace std::literals;
 
@@ -61,12 +64,6 @@ void expect_vec(const Vec3& v, double x, double y, double z) {
     EXPECT_DOUBLE_EQ(v.y, y);
     EXPECT_DOUBLE_EQ(v.z, z);
 }
-void expect_color(const Color& c, double r, double g, double b) {
-    EXPECT_DOUBLE_EQ(c.r, r);
-    EXPECT_DOUBLE_EQ(c.g, g);
-    EXPECT_DOUBLE_EQ(c.b, b);
-}
-
 // ---------------------------------------------------------------------------------------------
 // Defaults
 

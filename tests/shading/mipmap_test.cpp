@@ -9,7 +9,7 @@
 namespace drt {
 namespace {
 
-void expect_color(const Color& c, double r, double g, double b, double tolerance = 1e-6) {
+void expect_color_near(const Color& c, double r, double g, double b, double tolerance = 1e-6) {
     EXPECT_NEAR(c.r, r, tolerance);
     EXPECT_NEAR(c.g, g, tolerance);
     EXPECT_NEAR(c.b, b, tolerance);
@@ -29,15 +29,15 @@ Image two_by_two() {
 // bottom, and texel centres off by half a texel blend colours at the centres.
 TEST(MipMap, OriginIsTheBottomLeftAndTexelCentresAreAtHalves) {
     const MipMap map(two_by_two());
-    expect_color(map.texel(0, 0, 0), 0, 0, 1);  // bottom-left: blue
-    expect_color(map.bilinear(0, {0.25, 0.25}), 0, 0, 1);
-    expect_color(map.bilinear(0, {0.75, 0.25}), 1, 1, 1);
-    expect_color(map.bilinear(0, {0.25, 0.75}), 1, 0, 0);
-    expect_color(map.bilinear(0, {0.75, 0.75}), 0, 1, 0);
+    expect_color_near(map.texel(0, 0, 0), 0, 0, 1);  // bottom-left: blue
+    expect_color_near(map.bilinear(0, {0.25, 0.25}), 0, 0, 1);
+    expect_color_near(map.bilinear(0, {0.75, 0.25}), 1, 1, 1);
+    expect_color_near(map.bilinear(0, {0.25, 0.75}), 1, 0, 0);
+    expect_color_near(map.bilinear(0, {0.75, 0.75}), 0, 1, 0);
     ImageTexture texture(std::make_shared<const MipMap>(two_by_two()));
     TexturePoint at;
     at.uv = {0.25, 0.25};
-    expect_color(texture.value(at), 0, 0, 1);
+    expect_color_near(texture.value(at), 0, 0, 1);
 }
 
 // A ramp 0, 1, 2, 3 along u: bilinear lookups are linear between texel centres and wrap
@@ -59,7 +59,7 @@ TEST(MipMap, BilinearRampsAndRepeats) {
 TEST(MipMap, LevelsAreBoxFilteredDownToOneTexel) {
     const MipMap map(two_by_two());
     ASSERT_EQ(map.level_count(), 2);
-    expect_color(map.texel(1, 0, 0), 0.5, 0.5, 0.5);
+    expect_color_near(map.texel(1, 0, 0), 0.5, 0.5, 0.5);
     EXPECT_EQ(map.bytes(), 12u * 5);
     // 4096² over 13 levels: 12 bytes × (4^13 − 1) / 3 texels.
     EXPECT_EQ(MipMap::bytes_for(4096, 4096), 12u * ((std::uint64_t{1} << 26) - 1) / 3);

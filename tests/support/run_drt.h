@@ -15,18 +15,11 @@
 #include <string>
 #include <vector>
 
+#include "temp_folder.h"
+
 namespace drt::test {
 
 namespace fs = std::filesystem;
-
-inline std::string read_bytes(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-inline void write_bytes(const fs::path& path, const std::string& bytes) {
-    std::ofstream(path, std::ios::binary) << bytes;
-}
 
 // Runs a shell command line and returns its standard output.
 inline std::string shell_output(const std::string& command) {

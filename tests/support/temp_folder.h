@@ -1,14 +1,26 @@
 // A fresh, empty folder per test, named after it; removed afterwards unless the test failed, so
-// that what a failing test wrote can be looked at.
+// that what a failing test wrote can be looked at. And the whole-file reads and writes such tests
+// make.
 #pragma once
 
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 namespace drt::test {
+
+inline std::string read_bytes(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+inline void write_bytes(const std::filesystem::path& path, const std::string& bytes) {
+    std::ofstream(path, std::ios::binary) << bytes;
+}
 
 class TempFolderTest : public ::testing::Test {
   protected:

@@ -1,4 +1,4 @@
-// Geometry helpers shared by the unit tests.
+// Math and colour helpers shared by the unit tests.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -6,11 +6,27 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
+#include "drt/util/color.h"
 #include "drt/util/math.h"
 #include "drt/util/rng.h"
 
 namespace drt::testing {
+
+inline constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+// The i-th number of a reproducible uniform stream in [0, 1).
+inline double unit(std::uint64_t stream, std::uint64_t i) {
+    return to_unit(hash_of(stream, i));
+}
+
+// Each channel exactly as given.
+inline void expect_color(const Color& c, double r, double g, double b) {
+    EXPECT_DOUBLE_EQ(c.r, r);
+    EXPECT_DOUBLE_EQ(c.g, g);
+    EXPECT_DOUBLE_EQ(c.b, b);
+}
 
 // Succeeds when no component of a and b differs by more than tol, and says by how much otherwise.
 inline ::testing::AssertionResult near(const Vec3& a, const Vec3& b, double tol) {

@@ -18,6 +18,12 @@ inline Material& add_material(Scene& scene, Material m) {
     return *scene.materials.back();
 }
 
+// The default material, for objects whose material a test does not look at.
+inline const Material& plain_material() {
+    static const Material material{};
+    return material;
+}
+
 inline Material grey_lambert(double kd = 0.8) {
     Material m;
     m.name = "grey";

@@ -11,12 +11,10 @@
 #include "drt/geometry/plane.h"
 #include "drt/geometry/sphere.h"
 #include "drt/util/rng.h"
+#include "test_math.h"
 
 namespace drt::testing {
 
-inline double unit(std::uint64_t stream, std::uint64_t i) {
-    return to_unit(hash_of(stream, i));
-}
 inline Vec3 point_in(std::uint64_t stream, std::uint64_t i, double lo, double hi) {
     return {lo + (hi - lo) * unit(stream, 3 * i), lo + (hi - lo) * unit(stream, 3 * i + 1),
             lo + (hi - lo) * unit(stream, 3 * i + 2)};
