@@ -45,8 +45,9 @@ for scene in scenes:
           f"{pfm.relative_rmse(b, a):.4f}")
     curves = {}
     startups = {}  # per renderer: wall less start-up-excluded time, every run at every level
-    renderers = [n for n in ("drt", "drt-sobol", "cycles")
-                 if any(k[:2] == (scene, n) for k in by_key)]
+    drts = sorted({k[1] for k in by_key if k[0] == scene and k[1].startswith("drt")},
+                  key=lambda n: (len(n), n))
+    renderers = drts + ["cycles"]
     for renderer in renderers:
         ref = ref_data[renderer.split("-")[0]]
         points = []

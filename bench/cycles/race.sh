@@ -4,8 +4,9 @@
 # (scenes/gi/cornell-box.xml) and the Test1 room (bench/cycles/test1-room.xml), each scene's
 # Cycles twin built from the same XML by bench/cycles/twin.py. For each renderer: a converged
 # reference of its own (--ref-spp, another seed; drt's is rendered with the Sobol sampler, and
-# serves both drt runs), then renders at each of --levels spp, drt, drt-sobol, then Cycles,
-# round after round on --threads threads; bench/cycles/analyse.py prints each one's
+# serves every drt run), then renders at each of --levels spp, drt, drt-sobol, on the room
+# drt-sr2 (a shadow ray to each of its two lights), then Cycles, round after round on
+# --threads threads; bench/cycles/analyse.py prints each one's
 # relative RMSE against its own reference and the time to reach 2 %, 1 % and 0.5 %, start-up
 # included (the excluded time plus the median of each run's wall clock less its excluded time)
 # and excluded (Cycles: its log, from the first sample to
@@ -51,17 +52,20 @@ now() { date +%s.%N; }
 since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.3f", b - a }'; }
 
 # One render each; appends a row to runs.tsv.
-render_drt() {  # scene name spp seed round scale sampler
-    local image=$out/$2-drt-$7-$3-s$4.pfm start wall startup=0 name=drt
+render_drt() {  # scene name spp seed round scale sampler [shadow-rays]
+    local name=drt extra=()
     [ "$7" = stratified ] || name=drt-$7
+    [ -z "${8:-}" ] || { name=$name-sr$8; extra=(--shadow-rays "$8"); }
+    local image=$out/$2-$name-$3-s$4.pfm start wall startup=0
+    [ "$name" != drt ] || image=$out/$2-drt-stratified-$3-s$4.pfm
     if [ "$5" != ref ]; then
         start=$(now)
-        "$drt" "$1" --scale "$6" --spp 1 --threads "$threads" -q -o "$out/startup.pfm"
+        "$drt" "$1" --scale "$6" --spp 1 "${extra[@]}" --threads "$threads" -q -o "$out/startup.pfm"
         startup=$(since "$start")
     fi
     start=$(now)
     /usr/bin/time -f "%U %S" -o "$out/time" "$drt" "$1" --scale "$6" --spp "$3" --seed "$4" \
-        --sampler "$7" --threads "$threads" -q -o "$image"
+        --sampler "$7" "${extra[@]}" --threads "$threads" -q -o "$image"
     wall=$(since "$start")
     printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$2" "$name" "$3" "$5" "$wall" \
         "$(awk -v w="$wall" -v s="$startup" 'BEGIN { printf "%.3f", w - s }')" \
@@ -93,8 +97,11 @@ with open('$image.pfm', 'wb') as f:
 " >/dev/null 2>&1
 }
 
-scenes=("scenes/gi/cornell-box.xml cornell $(awk -v f="$scale" 'BEGIN { print 0.1 * f }')"
-        "bench/cycles/test1-room.xml test1 $(awk -v f="$scale" 'BEGIN { print 0.05 * f }')")
+# The fourth field: the room's light count, for a third drt run with a shadow ray per light at
+# every diffuse event (--shadow-rays 2) where the scene's own ShadowRays="1" picks one light
+# by power, as Cycles 3.4 does; "-" where there is one light only.
+scenes=("scenes/gi/cornell-box.xml cornell $(awk -v f="$scale" 'BEGIN { print 0.1 * f }') -"
+        "bench/cycles/test1-room.xml test1 $(awk -v f="$scale" 'BEGIN { print 0.05 * f }') 2")
 echo "cycles race: scale $scale (${scenes[*]}), levels $levels, references $ref_spp spp, $rounds rounds, $threads threads"
 echo "$(date -u '+%F %T') UTC, $(git rev-parse --short HEAD), load $(cut -d' ' -f1-3 /proc/loadavg)"
 for s in "${scenes[@]}"; do
@@ -109,6 +116,7 @@ for round in $(seq "$rounds"); do
         for spp in $levels; do
             render_drt "$1" "$2" "$spp" 0 "$round" "$3" stratified
             render_drt "$1" "$2" "$spp" 0 "$round" "$3" sobol
+            [ "$4" = - ] || render_drt "$1" "$2" "$spp" 0 "$round" "$3" stratified "$4"
             render_cycles "$1" "$2" "$spp" 0 "$round" "$3"
         done
     done
