@@ -11,17 +11,19 @@ root=$(pwd)  # absolute paths throughout: the cli target changes its working fol
 target=${1:?usage: tools/fuzz.sh scene|image|cli|obj|texture|mtl [SECONDS] | --build}
 seconds=${2:-60}
 
-# DRT_FUZZ_BUILT=1 skips the build step (tools/test.sh builds once, then runs targets side by side).
+# DRT_FUZZ_BUILT=1 skips the build step; DRT_FUZZ_DIR names a build folder other than build-fuzz/
+# (tools/test.sh fuzzes with its sanitizer build, which has the targets, and runs two side by side).
+dir=${DRT_FUZZ_DIR:-build-fuzz}
 if [ "${DRT_FUZZ_BUILT:-0}" != 1 ]; then
     launcher=()
     command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
     cxx=$(command -v clang++-14 || command -v clang++)
     # -O1 -g1 as for the sanitizer build in tools/test.sh: reports keep file and line, and the
     # build takes about 60 % of -O2 -g's time.
-    cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER="$cxx" \
+    cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER="$cxx" \
         -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DDRT_FUZZ=ON -DDRT_BUILD_TESTS=OFF -DDRT_PORTABLE=ON "${launcher[@]}" >/dev/null
-    # Quiet unless it fails (clang warns about other things than g++ does).
-    if ! log=$(cmake --build build-fuzz -j"$(nproc)" 2>&1); then
+    # Quiet unless it fails.
+    if ! log=$(cmake --build "$dir" -j"$(nproc)" 2>&1); then
         grep -E "error" <<<"$log" >&2 || tail -20 <<<"$log" >&2
         echo "fuzz.sh: build failed" >&2
         exit 1
@@ -29,9 +31,9 @@ if [ "${DRT_FUZZ_BUILT:-0}" != 1 ]; then
 fi
 [ "$target" = --build ] && exit 0
 
-binary=$root/build-fuzz/fuzz/fuzz_$target
+binary=$root/$dir/fuzz/fuzz_$target
 [ -x "$binary" ] || { echo "fuzz.sh: no target '$target' (scene, image, cli, obj, texture, mtl)" >&2; exit 2; }
-corpus=$root/build-fuzz/corpus/$target
+corpus=$root/$dir/corpus/$target
 mkdir -p "$corpus"
 if [ "$target" = scene ]; then
     cp -n scenes/*.xml scenes/*/*.xml "$corpus"/ 2>/dev/null || true
@@ -44,15 +46,15 @@ fi
 # -rss_limit_mb: above the largest allocation the limits allow, below what would trouble CI.
 # -timeout: no input may take this long (the targets keep renders tiny).
 "$binary" "$corpus" ${dict:+-dict="$dict"} -max_total_time="$seconds" -rss_limit_mb=4096 \
-    -timeout=30 -print_final_stats=1 -artifact_prefix="$root/build-fuzz/crash-$target-" 2>&1 |
+    -timeout=30 -print_final_stats=1 -artifact_prefix="$root/$dir/crash-$target-" 2>&1 |
     grep -E "^(#[0-9]+ *DONE|Done|stat::number_of_executed_units|stat::new_units_added)|ERROR|SUMMARY|Test unit written|crash-|timeout-|oom-|leak-|slow-unit" || true
 # libFuzzer's own exit status is lost in the pipe; an artefact is the verdict. A slow unit (over
 # 10 s) is named but does not fail the run: under a loaded sanitizer build one input's time varies
 # several-fold, so only a timeout (30 s) fails; long hunts find slow inputs (docs/testing.md).
-if compgen -G "build-fuzz/crash-$target-slow-unit-*" >/dev/null; then
-    echo "fuzz.sh: $target: slow input kept: $(ls build-fuzz/crash-"$target"-slow-unit-*)" >&2
+if compgen -G "$dir/crash-$target-slow-unit-*" >/dev/null; then
+    echo "fuzz.sh: $target: slow input kept: $(ls "$dir"/crash-"$target"-slow-unit-*)" >&2
 fi
-failures=$(compgen -G "build-fuzz/crash-$target-*" | grep -v -- "-slow-unit-" || true)
+failures=$(compgen -G "$dir/crash-$target-*" | grep -v -- "-slow-unit-" || true)
 if [ -n "$failures" ]; then
     echo "fuzz.sh: $target found a failure: $failures" >&2
     exit 1

@@ -10,7 +10,6 @@ Camera::Camera(Vec3 eye, Vec3 forward, Vec3 up_hint, double half_height, int wid
       right_(normalize(cross(up_hint, forward))),
       up_(cross(forward, right_)),
       forward_(forward),
-      half_height_(half_height),
       pixel_size_(2.0 * half_height / height),
       width_(width),
       height_(height),

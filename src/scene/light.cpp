@@ -72,7 +72,7 @@ DRT_VECTORISED void lit_cosine_batch(const Cone& cone, const Vec3& shading, cons
     for (std::size_t i = 0; i < count; ++i) {
         const ConeCoordinates c = cone.coordinates(u[i]);
         const double cosine = s.x * c.x + s.y * c.y + s.z * c.cos_t;
-        out[i] = (cosine > 0) & (g.x * c.x + g.y * c.y + g.z * c.cos_t > 0) ? cosine : 0.0;
+        out[i] = ((cosine > 0) & (g.x * c.x + g.y * c.y + g.z * c.cos_t > 0)) ? cosine : 0.0;
     }
 }
 

@@ -27,6 +27,7 @@
 #include "encoded_bytes.h"
 #include "regex_match.h"
 #include "run_drt.h"
+#include "sanitizers.h"
 #include "temp_folder.h"
 
 namespace drt {
@@ -1177,7 +1178,7 @@ TEST_F(CliTest, ABadErrorImagePathExitsTwoBeforeRendering) {
               "drt: --error-image takes one scene, not a batch\nRun 'drt --help' for usage.\n");
 }
 
-#if !defined(__SANITIZE_ADDRESS__)  // ASan reserves terabytes of address space up front
+#if !defined(DRT_TEST_ASAN)  // ASan reserves terabytes of address space up front
 TEST_F(CliTest, AllocationFailureInARenderFailsThatSceneOnly) {
     // 8192 x 8192 pixels: within the limits, but its 768 MiB image cannot be had under a 512 MiB
     // cap on the address space.

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "run_drt.h"
+#include "sanitizers.h"
 
 namespace drt {
 namespace {
@@ -204,7 +205,7 @@ TEST_F(ExrTest, TruncatedOrCorruptFilesThrowImageErrors) {
     const auto decode = [&](const std::string& data) {
         decode_exr(std::vector<unsigned char>(data.begin(), data.end()), bad);
     };
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(DRT_TEST_ASAN)
     // Under ASan a variant is slow (it clears the shadow of the large tables OpenEXR allocates
     // from a corrupt header): the sanitizer build tries every 7th, Release all of them.
     constexpr std::size_t kEvery = 7;

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "sanitizers.h"
+
 namespace drt {
 namespace {
 
@@ -39,7 +41,7 @@ std::string huge_page_mode() {
 // What a mesh's build relies on for its speed: an array asked for in huge pages gets them. Where
 // the kernel does not offer them at all, the hint is a no-op and there is nothing to check.
 TEST(HugePages, AnArrayAskedForHugePagesGetsThemWhereTheSystemOffersThem) {
-#ifdef __SANITIZE_ADDRESS__
+#ifdef DRT_TEST_ASAN
     GTEST_SKIP() << "AddressSanitizer's allocator maps memory its own way";
 #endif
     const std::string mode = huge_page_mode();

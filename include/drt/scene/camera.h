@@ -44,8 +44,7 @@ class Camera {
            Lens lens);
 
     Vec3 eye_, right_, up_, forward_;
-    double half_height_;  // of the image plane at distance 1
-    double pixel_size_;   // on that plane
+    double pixel_size_;  // on the image plane at distance 1
     int width_, height_;
     Lens lens_;
 };

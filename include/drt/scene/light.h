@@ -92,7 +92,7 @@ class SphereLight final : public Light {
 // from behind either adds nothing, and no shadow ray is cast for it.
 inline double lit_cosine(const Vec3& dir, const Vec3& shading, const Vec3& geometric) {
     const double cosine = dot(shading, dir);
-    return (cosine > 0) & (dot(geometric, dir) > 0) ? cosine : 0.0;
+    return ((cosine > 0) & (dot(geometric, dir) > 0)) ? cosine : 0.0;
 }
 
 // A direction in the cone of half-angle acos(cos_max) about +z, uniformly distributed over it
