@@ -8,8 +8,8 @@
 set -euo pipefail
 
 # openexr (exrheader) and chromium (a headless browser loading the regression reports) are for the
-# tests; clang-14 builds the fuzz targets, clang-format-14 checks the sources' layout; Open MPI:
-# drt runs under mpirun across processes and machines (docs/usage.md).
+# tests; clang-14 compiles the sanitizer build and its fuzz targets, clang-format-14 checks the
+# sources' layout; Open MPI: drt runs under mpirun across processes and machines (docs/usage.md).
 packages=(g++ cmake make pkg-config libtinyxml2-dev libstb-dev libcli11-dev libopenexr-dev
           libgtest-dev openexr chromium clang-14 libclang-rt-14-dev clang-format-14 libopenmpi-dev
           openmpi-bin)
