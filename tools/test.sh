@@ -31,6 +31,12 @@ run_tests build
 # the same bits as the Release build's from another compiler, instruction set and optimisation
 # level, and the fuzz targets (docs/testing.md).
 cxx=$(command -v clang++-14 || command -v clang++)
+# A build-sanitize/ that GCC configured (an older tools/test.sh) starts afresh: CMake cannot
+# switch a build folder to another compiler.
+if [ -f build-sanitize/CMakeCache.txt ] &&
+    ! grep -q "^CMAKE_CXX_COMPILER:.*clang" build-sanitize/CMakeCache.txt; then
+    rm -rf build-sanitize
+fi
 cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER="$cxx" \
     -DDRT_FUZZ=ON -DDRT_PORTABLE=ON -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" >/dev/null
 cmake --build build-sanitize -j"$jobs"
