@@ -19,7 +19,7 @@ if [ "${DRT_FUZZ_BUILT:-0}" != 1 ]; then
     command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
     cxx=$(command -v clang++-14 || command -v clang++)
     # -O1 -g1 as for the sanitizer build in tools/test.sh: reports keep file and line, and the
-    # build takes about 60 % of -O2 -g's time.
+    # build takes about half of -O2 -g's time.
     cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER="$cxx" \
         -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DDRT_FUZZ=ON -DDRT_BUILD_TESTS=OFF -DDRT_PORTABLE=ON "${launcher[@]}" >/dev/null
     # Quiet unless it fails.

@@ -44,7 +44,7 @@ run_tests build-sanitize
 
 tools/compare-builds.sh build/drt build-sanitize/drt
 
-# Each fuzz target for 30 s, two at a time: three minutes.
+# Each fuzz target for 30 s, two at a time: a minute and a half.
 fuzz_pair() {
     DRT_FUZZ_DIR=build-sanitize DRT_FUZZ_BUILT=1 tools/fuzz.sh "$1" 30 &
     local first=$!

@@ -57,7 +57,6 @@ render_drt() {  # scene name spp seed round scale sampler [shadow-rays]
     [ "$7" = stratified ] || name=drt-$7
     [ -z "${8:-}" ] || { name=$name-sr$8; extra=(--shadow-rays "$8"); }
     local image=$out/$2-$name-$3-s$4.pfm start wall startup=0
-    [ "$name" != drt ] || image=$out/$2-drt-stratified-$3-s$4.pfm
     if [ "$5" != ref ]; then
         start=$(now)
         "$drt" "$1" --scale "$6" --spp 1 "${extra[@]}" --threads "$threads" -q -o "$out/startup.pfm"

@@ -25,9 +25,8 @@ namespace {
 namespace fs = std::filesystem;
 using namespace test;
 
-const fs::path kSource = DRT_SOURCE_DIR;
 // Motion blur, depth of field, glossy reflection and soft shadows in one scene.
-const fs::path kEffects = kSource / "scenes/thesis/test5.xml";
+const fs::path kEffects = kSourceDir / "scenes/thesis/test5.xml";
 
 Scene small_scene(const fs::path& file = kEffects) {
     LoadedScene loaded = load_scene(file);
@@ -143,7 +142,7 @@ TEST(Checkpoint, IdentityCoversTheSceneBytesAndEverySettingButNotHowTheWorkIsDon
     EXPECT_TRUE(differs([](RenderSettings& s, auto&) { s.sampler = "sobol"; }));
     EXPECT_TRUE(differs([](RenderSettings& s, auto&) { s.pixel_plane_unit *= 1 + 1e-15; }));
     EXPECT_TRUE(differs([](auto&, auto& a) { a = AdaptiveSampling{0.01, 16}; }));
-    const fs::path other = kSource / "scenes/thesis/test6.xml";
+    const fs::path other = kSourceDir / "scenes/thesis/test6.xml";
     EXPECT_NE(identify_render(std::vector{other}, scene.settings, std::nullopt, 12).files,
               base.files);
     // Every file the scene reads, on its own and by its bytes alone.
@@ -317,7 +316,7 @@ TEST_F(TempDir, RendersStoppedAndResumedAtSeveralPointsGiveThePlainRendersBits) 
 }
 
 TEST_F(TempDir, APathRenderStoppedAndResumedGivesThePlainRendersBitsAndDiffuseRays) {
-    const fs::path cornell = kSource / "scenes/gi/cornell-box.xml";
+    const fs::path cornell = kSourceDir / "scenes/gi/cornell-box.xml";
     const Scene scene = small_scene(cornell);
     const RenderResult reference = plain(scene, std::nullopt);
     ASSERT_GT(reference.stats.rays.diffuse, 0u);
@@ -343,7 +342,7 @@ TEST_F(TempDir, APathRenderStoppedAndResumedGivesThePlainRendersBitsAndDiffuseRa
 
 TEST_F(TempDir, ACausticRenderStoppedAndResumedGivesThePlainRendersBits) {
     // The resumed run builds its photon maps anew: they are functions of (seed, pass) alone.
-    const fs::path caustic = kSource / "scenes/caustics/test1-caustic.xml";
+    const fs::path caustic = kSourceDir / "scenes/caustics/test1-caustic.xml";
     const Scene scene = small_scene(caustic);
     const RenderResult reference = plain(scene, std::nullopt);
     ASSERT_GT(reference.stats.photons, 0u);
@@ -473,7 +472,7 @@ TEST_F(CheckpointCli, DamagedTruncatedAndForeignCheckpointsExitTwoAndChangeNothi
     EXPECT_NE(r.err.find("checkpoint of another render: made by other options"), std::string::npos)
         << r.err;
     std::vector<std::string> other = command("out.pfm", {"--checkpoint", "c.ckpt"});
-    other[0] = (kSource / "scenes/thesis/test6.xml").string();
+    other[0] = (kSourceDir / "scenes/thesis/test6.xml").string();
     r = run(other);
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("made by another scene file"), std::string::npos) << r.err;

@@ -59,7 +59,6 @@ TEST(BoundByMpirunDefault, OnlyMpirunsOwnBindingIsUndone) {
     EXPECT_FALSE(with({{"OMPI_MCA_orte_bound_at_launch", "0"}}));
 }
 
-const fs::path kSourceDir = DRT_SOURCE_DIR;
 // Motion blur, depth of field, glossy reflection, soft shadows.
 const std::string kMotion = (kSourceDir / "scenes/thesis/test5.xml").string();
 // Glossy reflection and refraction, depth of field, soft shadows.

@@ -131,7 +131,7 @@ TEST(EnvironmentRender, ShadowRaysAreSharedWithTheLightsByPower) {
     EXPECT_TRUE(plan.effects.soft_shadows);
 }
 
-double image_rmse(const Image& a, const Image& b) {
+double luminance_rmse(const Image& a, const Image& b) {
     double sum = 0;
     for (int y = 0; y < a.height; ++y) {
         for (int x = 0; x < a.width; ++x) {
@@ -159,9 +159,9 @@ TEST(EnvironmentRender, ImportanceSamplingIsLessNoisyThanUniformSampling) {
     };
     const Image reference = render_with(scene(4096, Environment::Sampling::kLuminance)).image;
     const double importance =
-        image_rmse(render_with(scene(16, Environment::Sampling::kLuminance)).image, reference);
+        luminance_rmse(render_with(scene(16, Environment::Sampling::kLuminance)).image, reference);
     const double uniform =
-        image_rmse(render_with(scene(16, Environment::Sampling::kUniform)).image, reference);
+        luminance_rmse(render_with(scene(16, Environment::Sampling::kUniform)).image, reference);
     EXPECT_GT(importance, 0);
     EXPECT_LT(importance * 8, uniform) << importance << " " << uniform;
 }

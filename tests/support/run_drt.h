@@ -21,6 +21,9 @@ namespace drt::test {
 
 namespace fs = std::filesystem;
 
+// The source tree, for its scenes.
+inline const fs::path kSourceDir = DRT_SOURCE_DIR;
+
 // Runs a shell command line and returns its standard output.
 inline std::string shell_output(const std::string& command) {
     std::string text;
