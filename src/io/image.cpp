@@ -78,28 +78,6 @@ Bytes encode_pfm(const Image& image) {
 
 // ---- decoding -------------------------------------------------------------------------------
 
-// A device, a pipe or a folder named like an image is refused before reading.
-Bytes read_image_file(const fs::path& path) {
-    try {
-        return read_binary_file(path, kMaxImageFileBytes, FileKinds::regular_only);
-    } catch (const FileReadError& e) {
-        switch (e.problem()) {
-            case FileProblem::cannot_open:
-                fail(path, "cannot open file: " + e.reason());
-            case FileProblem::cannot_read:
-                fail(path, "cannot read file: " + e.reason());
-            case FileProblem::is_folder:
-                fail(path, "is a folder, not an image file");
-            case FileProblem::not_regular_file:
-                fail(path, "not a regular file");
-            case FileProblem::too_large:
-                break;
-        }
-        fail(path, "file larger than the " + std::to_string(kMaxImageFileBytes >> 20) +
-                       " MiB limit for an image");
-    }
-}
-
 bool starts_with(const Bytes& data, std::string_view magic) {
     return data.size() >= magic.size() && std::memcmp(data.data(), magic.data(), magic.size()) == 0;
 }
@@ -227,6 +205,27 @@ Image decode_pfm(const Bytes& data, const fs::path& path) {
 }
 
 }  // namespace
+
+std::vector<unsigned char> read_image_file(const fs::path& path) {
+    try {
+        return read_binary_file(path, kMaxImageFileBytes, FileKinds::regular_only);
+    } catch (const FileReadError& e) {
+        switch (e.problem()) {
+            case FileProblem::cannot_open:
+                fail(path, "cannot open file: " + e.reason());
+            case FileProblem::cannot_read:
+                fail(path, "cannot read file: " + e.reason());
+            case FileProblem::is_folder:
+                fail(path, "is a folder, not an image file");
+            case FileProblem::not_regular_file:
+                fail(path, "not a regular file");
+            case FileProblem::too_large:
+                break;
+        }
+        fail(path, "file larger than the " + std::to_string(kMaxImageFileBytes >> 20) +
+                       " MiB limit for an image");
+    }
+}
 
 ImageFormat format_for_path(const fs::path& path) {
     std::string ext = path.extension().string();

@@ -13,7 +13,6 @@
 #include "drt/io/exr.h"
 #include "drt/io/png_chunks.h"
 #include "drt/util/byte_order.h"
-#include "drt/util/file_reader.h"
 #include "drt/util/limits.h"
 #include "drt/util/text.h"
 
@@ -237,26 +236,7 @@ Image decode_texture(const Bytes& data, const fs::path& path, TextureEncoding en
 }
 
 Image read_texture(const fs::path& path, TextureEncoding encoding) {
-    Bytes data;
-    try {
-        data = read_binary_file(path, kMaxImageFileBytes, FileKinds::regular_only);
-    } catch (const FileReadError& e) {
-        switch (e.problem()) {
-            case FileProblem::cannot_open:
-                fail(path, "cannot open file: " + e.reason());
-            case FileProblem::cannot_read:
-                fail(path, "cannot read file: " + e.reason());
-            case FileProblem::is_folder:
-                fail(path, "is a folder, not an image file");
-            case FileProblem::not_regular_file:
-                fail(path, "not a regular file");
-            case FileProblem::too_large:
-                break;
-        }
-        fail(path, "file larger than the " + std::to_string(kMaxImageFileBytes >> 20) +
-                       " MiB limit for an image");
-    }
-    return decode_texture(data, path, encoding);
+    return decode_texture(read_image_file(path), path, encoding);
 }
 
 }  // namespace drt

@@ -77,20 +77,11 @@ Integrator::Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bv
 void Integrator::sample_pixel(int x, int y, const PixelSample& s, std::span<Color> out,
                               RayCounts& counts) const {
     PixelWork work{counts, RunPoints(sampler_, s, static_cast<std::uint32_t>(out.size()))};
-    const Effects& e = plan_.effects;
-    std::vector<Vec2> film(out.size(), Vec2{x + 0.5, y + 0.5});
-    if (e.antialiasing) {
-        sampler_.get_2d_run(s, dim::kPixel, film);
-        for (Vec2& f : film) f = {x + f.x, y + f.y};
-    }
-    std::vector<Vec2> lens(out.size(), Vec2{0.5, 0.5});
-    if (e.depth_of_field) sampler_.get_2d_run(s, dim::kLens, lens);
+    const CameraRays rays(camera_, sampler_, plan_, x, y, s, out.size());
     PixelSample sample = s;
     for (std::size_t i = 0; i < out.size(); ++i, ++sample.index) {
-        const double time =
-            e.motion_blur ? sampler_.get_1d(sample, dim::kTime) * plan_.shutter_end : 0.0;
         ++counts.camera;
-        out[i] = radiance(camera_.generate_ray(film[i], lens[i], time), sample, 0, work);
+        out[i] = radiance(rays.at(i, sample), sample, 0, work);
     }
 }
 
@@ -210,22 +201,34 @@ Color Integrator::light_ray(const Light& light, const LightSample& ls, const Vec
     return light.intensity() * cosine;
 }
 
+std::optional<ReachingEmitter> reach_emitter(const Emitters& emitters, const Bvh& bvh,
+                                             std::size_t emitter, Vec2 u, const Vec3& point,
+                                             const Vec3& origin, Leaving leaving,
+                                             const Vec3& geometric, const Vec3& shading,
+                                             double time, RayCounts& counts) {
+    const auto sample = emitters.sample(emitter, point, u, time);
+    if (!sample) return std::nullopt;
+    const double cosine = lit_cosine(sample->dir, shading, geometric);
+    if (cosine == 0) return std::nullopt;
+    ++counts.shadow;
+    const bool point_light = emitters.is_point(emitter);
+    // An emitting surface is in the BVH: the ray stops just short of it.
+    const double reach = point_light ? sample->distance : sample->distance * kShortOfEmitter;
+    if (bvh.occluded({origin, sample->dir, time}, {0, reach}, leaving)) return std::nullopt;
+    return ReachingEmitter{*sample, cosine, point_light};
+}
+
 Color Integrator::emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point, const Vec3& origin,
                               Leaving leaving, const Vec3& geometric, const Vec3& shading,
                               double time, RayCounts& counts) const {
-    const auto sample = plan_.emitters.sample(emitter, point, u, time);
-    if (!sample) return {};
-    const double cosine = lit_cosine(sample->dir, shading, geometric);
-    if (cosine == 0) return {};
-    ++counts.shadow;
-    const bool point_light = plan_.emitters.is_point(emitter);
-    // An emitting surface is in the BVH: the ray stops just short of it.
-    const double reach = point_light ? sample->distance : sample->distance * kShortOfEmitter;
-    if (bvh_.occluded({origin, sample->dir, time}, {0, reach}, leaving)) return {};
+    const auto reached = reach_emitter(plan_.emitters, bvh_, emitter, u, point, origin, leaving,
+                                       geometric, shading, time, counts);
+    if (!reached) return {};
+    const auto& [sample, cosine, point_light] = *reached;
     // In the units of the thesis's sum of lights, which the diffuse part multiplies by
     // diffuse·kd: irradiance over π, estimated as radiance·cos/pdf.
-    if (point_light) return sample->radiance * cosine;
-    return sample->radiance * (cosine / (kPi * sample->pdf));
+    if (point_light) return sample.radiance * cosine;
+    return sample.radiance * (cosine / (kPi * sample.pdf));
 }
 
 Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const Vec3& shading,

@@ -83,20 +83,11 @@ PathIntegrator::PathIntegrator(const Scene& scene, const RenderPlan& plan, const
 
 void PathIntegrator::sample_pixel(int x, int y, const PixelSample& s, std::span<Color> out,
                                   RayCounts& counts) const {
-    const Effects& e = plan_.effects;
-    std::vector<Vec2> film(out.size(), Vec2{x + 0.5, y + 0.5});
-    if (e.antialiasing) {
-        sampler_.get_2d_run(s, dim::kPixel, film);
-        for (Vec2& f : film) f = {x + f.x, y + f.y};
-    }
-    std::vector<Vec2> lens(out.size(), Vec2{0.5, 0.5});
-    if (e.depth_of_field) sampler_.get_2d_run(s, dim::kLens, lens);
+    const CameraRays rays(camera_, sampler_, plan_, x, y, s, out.size());
     PixelSample sample = s;
     for (std::size_t i = 0; i < out.size(); ++i, ++sample.index) {
-        const double time =
-            e.motion_blur ? sampler_.get_1d(sample, dim::kTime) * plan_.shutter_end : 0.0;
         ++counts.camera;
-        out[i] = radiance(camera_.generate_ray(film[i], lens[i], time), sample, counts);
+        out[i] = radiance(rays.at(i, sample), sample, counts);
         // The opt-in clamp (biased): the whole sample scaled, so that its colour is kept.
         const double clamp = scene_.settings.clamp;
         if (clamp > 0 && luminance(out[i]) > clamp) out[i] = out[i] * (clamp / luminance(out[i]));
@@ -279,20 +270,16 @@ Color PathIntegrator::emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point
                                   const Vec3& origin, Leaving leaving, const Vec3& geometric,
                                   const Vec3& shading, double time, double diffuse_pick,
                                   RayCounts& counts) const {
-    const auto sample = plan_.emitters.sample(emitter, point, u, time);
-    if (!sample) return {};
-    const double cosine = lit_cosine(sample->dir, shading, geometric);
-    if (cosine == 0) return {};
-    ++counts.shadow;
-    const bool point_light = plan_.emitters.is_point(emitter);
-    const double reach = point_light ? sample->distance : sample->distance * kShortOfEmitter;
-    if (bvh_.occluded({origin, sample->dir, time}, {0, reach}, leaving)) return {};
-    if (point_light) return sample->radiance * cosine;
+    const auto reached = reach_emitter(plan_.emitters, bvh_, emitter, u, point, origin, leaving,
+                                       geometric, shading, time, counts);
+    if (!reached) return {};
+    const auto& [sample, cosine, point_light] = *reached;
+    if (point_light) return sample.radiance * cosine;
     const double weight =
         strategy_ == Strategy::kMis
-            ? power_heuristic(emitter_rays_[emitter] * sample->pdf, diffuse_pick * cosine / kPi)
+            ? power_heuristic(emitter_rays_[emitter] * sample.pdf, diffuse_pick * cosine / kPi)
             : 1.0;
-    return sample->radiance * (cosine * weight / (kPi * sample->pdf));
+    return sample.radiance * (cosine * weight / (kPi * sample.pdf));
 }
 
 Color PathIntegrator::next_event(const Vec3& point, const Vec3& geometric, const Vec3& shading,

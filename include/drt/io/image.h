@@ -75,6 +75,10 @@ double decode_srgb(double encoded);
 void write_image(const Image& image, const std::filesystem::path& path,
                  const ImageWriteOptions& options = {});
 
+// The bytes of an image file (at most kMaxImageFileBytes); a folder, a device, a pipe or a file
+// that cannot be read throws ImageError naming the file, before any decoding.
+std::vector<unsigned char> read_image_file(const std::filesystem::path& path);
+
 // Reads .png/.bmp as stored values / 255 (still sRGB-encoded), .pfm and .exr as their floats.
 Image read_image(const std::filesystem::path& path);
 

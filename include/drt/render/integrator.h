@@ -15,6 +15,7 @@
 #include "drt/render/render_plan.h"
 #include "drt/sampling/sampler.h"
 #include "drt/scene/camera.h"
+#include "drt/scene/emitters.h"
 #include "drt/scene/scene.h"
 
 namespace drt {
@@ -38,6 +39,23 @@ inline Leaving shadow_leaving(const SurfaceHit& surface, const Hit& hit) {
 // short (about 100 float roundings) that a mesh's float filter rules the emitter's triangles
 // out without the double-precision test.
 inline constexpr double kShortOfEmitter = 1 - 1e-5;
+
+// A next-event sample of emitter `emitter` that lights `point`: its sample, the cosine it arrives
+// at, and whether the emitter is a point (a single direction, no density).
+struct ReachingEmitter {
+    EmitterSample sample;
+    double cosine;
+    bool point_light;
+};
+// Both integrators' shadow ray towards an emitter for the point u of the unit square, from
+// `origin` (spawned off `point`), skipping the triangle `leaving`, stopped short of an emitting
+// surface (kShortOfEmitter); nothing when the sample cannot light the point or is blocked.
+// Counts the ray if one is traced.
+std::optional<ReachingEmitter> reach_emitter(const Emitters& emitters, const Bvh& bvh,
+                                             std::size_t emitter, Vec2 u, const Vec3& point,
+                                             const Vec3& origin, Leaving leaving,
+                                             const Vec3& geometric, const Vec3& shading,
+                                             double time, RayCounts& counts);
 
 // A direction about `ideal` whose angle from it is Rayleigh-distributed with scale sigma, i.e.
 // a 2-D normal distribution of standard deviation sigma (radians) on the tangent plane.

@@ -6,11 +6,13 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <vector>
 
 #include "drt/accel/bvh.h"
 #include "drt/render/photon_map.h"
 #include "drt/render/render_plan.h"
 #include "drt/sampling/sampler.h"
+#include "drt/scene/camera.h"
 #include "drt/scene/scene.h"
 #include "drt/util/color.h"
 
@@ -27,6 +29,24 @@ struct RayCounts {
             refraction += o.refraction, diffuse += o.diffuse;
         return *this;
     }
+};
+
+// The camera rays of samples s.index, s.index + 1, ... of pixel (x, y), as both integrators trace
+// them: the film and lens points drawn as one run (so that a stratified or Sobol pattern spreads
+// a run over the pixel and the lens together), the pixel's centre without antialiasing, the
+// lens's centre without depth of field, and a time only with motion blur.
+class CameraRays {
+  public:
+    CameraRays(const Camera& camera, const Sampler& sampler, const RenderPlan& plan, int x, int y,
+               const PixelSample& s, std::size_t count);
+    // The ray of the run's i-th sample, `sample` (s with index s.index + i).
+    Ray at(std::size_t i, const PixelSample& sample) const;
+
+  private:
+    const Camera& camera_;
+    const Sampler& sampler_;
+    const RenderPlan& plan_;
+    std::vector<Vec2> film_, lens_;
 };
 
 class PixelIntegrator {
