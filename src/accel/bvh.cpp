@@ -375,7 +375,7 @@ bool Bvh::occluded(const Ray& ray, Interval range, std::uint64_t planes, Leaving
 }
 
 bool Bvh::occluded_by(const Ray& ray, Interval range, std::uint64_t planes,
-                      std::span<const std::uint32_t> primitives) const {
+                      std::span<const std::uint32_t> primitives, Leaving leaving) const {
     const double origin_scale = max_abs_component(ray.origin);
     for (std::uint64_t left = planes; left != 0; left &= left - 1) {
         const PlaneData& p = planes_[static_cast<std::size_t>(std::countr_zero(left))];
@@ -390,10 +390,9 @@ bool Bvh::occluded_by(const Ray& ray, Interval range, std::uint64_t planes,
     std::uint32_t triangle = 0;
     Vec2 uv;
     for (const std::uint32_t i : primitives) {
-        if (hit<true>(primitives_[i], ray, origin_scale, range, TriangleMesh::kNoTriangle, triangle,
-                      uv)) {
-            return true;
-        }
+        const std::uint32_t skip =
+            leaving.piece == i ? leaving.triangle : TriangleMesh::kNoTriangle;
+        if (hit<true>(primitives_[i], ray, origin_scale, range, skip, triangle, uv)) return true;
     }
     return false;
 }

@@ -92,17 +92,18 @@ Occluders::Occluders(const Bvh& bvh, const Vec3& origin, const Ball& target, dou
     reach_ = every_plane_masked && planes_ == 0 && count_ == 0 ? Reach::kNothing : Reach::kListed;
 }
 
-bool Occluders::occluded(const Bvh& bvh, const Ray& ray, Interval range) const {
+bool Occluders::occluded(const Bvh& bvh, const Ray& ray, Interval range, Leaving leaving) const {
     switch (reach_) {
         case Reach::kNothing:
             return false;
         case Reach::kListed:
             return bvh.occluded_by(ray, range, planes_,
-                                   std::span<const std::uint32_t>(primitives_).first(count_));
+                                   std::span<const std::uint32_t>(primitives_).first(count_),
+                                   leaving);
         case Reach::kTraverse:
             break;
     }
-    return bvh.occluded(ray, range, planes_);
+    return bvh.occluded(ray, range, planes_, leaving);
 }
 
 bool worth_culling(int rays, const Bvh& /*bvh*/) {

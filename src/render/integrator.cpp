@@ -192,12 +192,12 @@ Color Integrator::scattered(const Vec3& point, const Vec3& geometric, Leaving le
 }
 
 Color Integrator::light_ray(const Light& light, const LightSample& ls, const Vec3& origin,
-                            const Vec3& geometric, const Vec3& shading, double time,
-                            const Occluders& occluders, RayCounts& counts) const {
+                            Leaving leaving, const Vec3& geometric, const Vec3& shading,
+                            double time, const Occluders& occluders, RayCounts& counts) const {
     const double cosine = lit_cosine(ls.dir, shading, geometric);
     if (cosine == 0) return {};  // no ray needed
     ++counts.shadow;
-    if (occluders.occluded(bvh_, {origin, ls.dir, time}, {0, ls.distance})) return {};
+    if (occluders.occluded(bvh_, {origin, ls.dir, time}, {0, ls.distance}, leaving)) return {};
     return light.intensity() * cosine;
 }
 
@@ -277,7 +277,7 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
             }
             light.sample(point, chunk, std::span(samples).first(n));
             for (std::size_t j = 0; j < n; ++j) {
-                light_sum += light_ray(light, samples[j], origin, geometric, shading, time,
+                light_sum += light_ray(light, samples[j], origin, leaving, geometric, shading, time,
                                        occluders, counts);
             }
         }
@@ -320,8 +320,8 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
             }
             if (!plan_.effects.soft_shadows) u = kLightCentre;
             const Light& light = *area_lights_[k];
-            sum += light_ray(light, light.sample(point, u), origin, geometric, shading, time,
-                             Occluders{}, counts) /
+            sum += light_ray(light, light.sample(point, u), origin, leaving, geometric, shading,
+                             time, Occluders{}, counts) /
                    (p * rays);
         }
     }

@@ -326,8 +326,9 @@ bool PhotonMaps::trace_one(std::uint64_t key, Photon& out) const {
     const Effects& effects = plan_.effects;
     const double start = max_component(power);
     const int max_depth = scene_.settings.max_depth;
+    Leaving leaving;  // the triangle the ray leaves from, after the first event
     for (int events = 0;; ++events) {
-        const auto hit = bvh_.intersect(ray, {0, kInfinity});
+        const auto hit = bvh_.intersect(ray, {0, kInfinity}, leaving);
         if (!hit) return false;
         const Material& m = hit->object->material();
         const SurfaceHit surface = hit->object->surface_at(ray, *hit);
@@ -387,6 +388,7 @@ bool PhotonMaps::trace_one(std::uint64_t key, Photon& out) const {
             }
         }
         ray = spawn_ray(surface.point, geometric, dir, time);
+        leaving = Bvh::leaving(*hit);
     }
 }
 

@@ -55,7 +55,7 @@ class Bvh {
     bool occluded(const Ray& ray, Interval range, std::uint64_t planes, Leaving leaving = {}) const;
     // The same, testing only the listed primitives (as visit_near names them) of the tree.
     bool occluded_by(const Ray& ray, Interval range, std::uint64_t planes,
-                     std::span<const std::uint32_t> primitives) const;
+                     std::span<const std::uint32_t> primitives, Leaving leaving = {}) const;
     // Calls visit(i) for each primitive i present at `time` whose ball at that time passes
     // `may_meet` (a conservative test of a Ball), skipping subtrees whose bounding ball fails
     // it; stops, returning false, as soon as visit returns false.

@@ -40,8 +40,8 @@ class Occluders {
     // Whether every ray reaches the light, so that shading needs only the cosines.
     bool every_ray_reaches() const { return reach_ == Reach::kNothing; }
     // Whether something blocks `ray` (from the origin, to a point of the target, at the time
-    // the occluders were gathered for) within `range`.
-    bool occluded(const Bvh& bvh, const Ray& ray, Interval range) const;
+    // the occluders were gathered for) within `range`; the triangle `leaving` is skipped (bvh.h).
+    bool occluded(const Bvh& bvh, const Ray& ray, Interval range, Leaving leaving = {}) const;
 
     std::uint64_t planes() const { return planes_; }
     int count() const { return count_; }

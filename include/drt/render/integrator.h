@@ -99,13 +99,13 @@ class Integrator final : public PixelIntegrator {
     // `leaving`: the triangle the ray leaves from, which it skips (bvh.h).
     Color radiance(const Ray& ray, const PixelSample& s, int depth, PixelWork& work,
                    Leaving leaving = {}) const;
-    // Σ lights at a point: I · max(0, N·ω) · visibility, averaged over each light's shadow rays;
-    // emitters' shadow rays skip the triangle `leaving`.
+    // Σ lights at a point: I · max(0, N·ω) · visibility, averaged over each light's shadow rays,
+    // which skip the triangle `leaving`.
     Color direct_light(const Vec3& point, const Vec3& geometric, const Vec3& shading,
                        Leaving leaving, double time, const PixelSample& s, int depth,
                        RayCounts& counts) const;
     // One shadow ray from `origin` (spawned off the shading point) along a light sample.
-    Color light_ray(const Light& light, const LightSample& ls, const Vec3& origin,
+    Color light_ray(const Light& light, const LightSample& ls, const Vec3& origin, Leaving leaving,
                     const Vec3& geometric, const Vec3& shading, double time,
                     const Occluders& occluders, RayCounts& counts) const;
     // One shadow ray towards emitter `emitter` (emitters.h) for the point u of the unit square,
