@@ -11,9 +11,12 @@
 #include <memory>
 #include <vector>
 
+#include "drt/accel/mesh.h"
+#include "drt/accel/triangle_mesh.h"
 #include "drt/geometry/plane.h"
 #include "drt/geometry/sphere.h"
 #include "drt/render/integrator.h"
+#include "test_meshes.h"
 #include "test_world.h"
 
 namespace drt {
@@ -167,6 +170,35 @@ TEST(Occluders, ALoneRayIsTracedWithoutCulling) {
     EXPECT_FALSE(worth_culling(1, bvh));
     EXPECT_TRUE(worth_culling(2, bvh));
     EXPECT_TRUE(worth_culling(3, bvh));
+}
+
+// A shadow ray leaving a mesh triangle skips it however the occluders send it on: through the
+// list of primitives near the cone or through the whole tree. Two placements of one triangle,
+// the second one unit above the first: told to skip the first, a ray meets only the second.
+TEST(Occluders, PassTheTriangleARayLeavesOnToTheTree) {
+    Material material;
+    testing::TestMesh flat;
+    flat.vertices = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}};
+    flat.triangles = {{0, 1, 2}};
+    const auto triangle =
+        std::make_shared<const TriangleMesh>(testing::obj_of(flat), MeshTransform{}, false);
+    std::vector<std::unique_ptr<Object>> objects;
+    objects.push_back(std::make_unique<Mesh>(triangle, std::vector<Vec3>{Vec3{}}, material));
+    objects.push_back(std::make_unique<Mesh>(triangle, std::vector<Vec3>{Vec3{0, 0, 1}}, material));
+    const Bvh bvh(objects);
+    const Ray up{{1, 1, -3}, {0, 0, 1}};
+    const auto first = bvh.intersect(up, {0, kInfinity});
+    ASSERT_TRUE(first);
+    ASSERT_EQ(first->object, objects[0].get());
+    const Leaving skip_first = Bvh::leaving(*first);
+    const Occluders listed(bvh, up.origin, Ball{{1, 1, 6}, 0.5}, 0);
+    ASSERT_EQ(listed.reach(), Occluders::Reach::kListed);
+    ASSERT_EQ(listed.count(), 2);
+    for (const Occluders& occluders : {listed, Occluders{}}) {
+        EXPECT_TRUE(occluders.occluded(bvh, up, {0, 3.5}));
+        EXPECT_FALSE(occluders.occluded(bvh, up, {0, 3.5}, skip_first));
+        EXPECT_TRUE(occluders.occluded(bvh, up, {0, 4.5}, skip_first));
+    }
 }
 
 }  // namespace
