@@ -210,17 +210,8 @@ TEST(Bvh, RaysLeavingAMeshTriangleFindWhatTheyFindWithoutSkippingIt) {
 // The skip names a triangle of one placed piece: the same mesh placed again, one unit above,
 // is met by the ray leaving the first placement's copy of the same triangle.
 TEST(Bvh, ALeavingRaySkipsItsOwnPlacementOfASharedMeshAlone) {
-    Material material;
-    testing::TestMesh flat;
-    flat.vertices = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}};
-    flat.triangles = {{0, 1, 2}};
-    const auto triangle =
-        std::make_shared<const TriangleMesh>(testing::obj_of(flat), MeshTransform{}, false);
-    std::vector<std::unique_ptr<Object>> objects;
-    objects.push_back(std::make_unique<Mesh>(triangle, std::vector<Vec3>{Vec3{}}, material));
-    objects.push_back(std::make_unique<Mesh>(triangle, std::vector<Vec3>{Vec3{0, 0, 1}}, material));
-    const Bvh bvh(objects);
-    const Ray up{{1, 1, -3}, {0, 0, 1}};
+    const testing::StackedTriangles stacked;
+    const auto& [material, objects, bvh, up] = stacked;
     const auto first = bvh.intersect(up, {0, kInfinity});
     ASSERT_TRUE(first);
     EXPECT_EQ(first->object, objects[0].get());

@@ -11,12 +11,9 @@
 #include <memory>
 #include <vector>
 
-#include "drt/accel/mesh.h"
-#include "drt/accel/triangle_mesh.h"
 #include "drt/geometry/plane.h"
 #include "drt/geometry/sphere.h"
 #include "drt/render/integrator.h"
-#include "test_meshes.h"
 #include "test_world.h"
 
 namespace drt {
@@ -173,23 +170,12 @@ TEST(Occluders, ALoneRayIsTracedWithoutCulling) {
 }
 
 // A shadow ray leaving a mesh triangle skips it however the occluders send it on: through the
-// list of primitives near the cone or through the whole tree. Two placements of one triangle,
-// the second one unit above the first: told to skip the first, a ray meets only the second.
+// list of primitives near the cone or through the whole tree.
 TEST(Occluders, PassTheTriangleARayLeavesOnToTheTree) {
-    Material material;
-    testing::TestMesh flat;
-    flat.vertices = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}};
-    flat.triangles = {{0, 1, 2}};
-    const auto triangle =
-        std::make_shared<const TriangleMesh>(testing::obj_of(flat), MeshTransform{}, false);
-    std::vector<std::unique_ptr<Object>> objects;
-    objects.push_back(std::make_unique<Mesh>(triangle, std::vector<Vec3>{Vec3{}}, material));
-    objects.push_back(std::make_unique<Mesh>(triangle, std::vector<Vec3>{Vec3{0, 0, 1}}, material));
-    const Bvh bvh(objects);
-    const Ray up{{1, 1, -3}, {0, 0, 1}};
+    const testing::StackedTriangles stacked;
+    const auto& [material, objects, bvh, up] = stacked;
     const auto first = bvh.intersect(up, {0, kInfinity});
-    ASSERT_TRUE(first);
-    ASSERT_EQ(first->object, objects[0].get());
+    ASSERT_TRUE(first && first->object == objects[0].get());
     const Leaving skip_first = Bvh::leaving(*first);
     const Occluders listed(bvh, up.origin, Ball{{1, 1, 6}, 0.5}, 0);
     ASSERT_EQ(listed.reach(), Occluders::Reach::kListed);

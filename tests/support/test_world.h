@@ -1,5 +1,6 @@
-// A random world of planes and (partly moving) spheres, for tests that compare the BVH and the
-// shadow-ray culling with testing every object.
+// Worlds for the BVH's and the shadow-ray culling's tests: a random one of planes and (partly
+// moving) spheres, to compare with testing every object, and two stacked triangles, for the skip
+// of the triangle a ray leaves.
 #pragma once
 
 #include <cmath>
@@ -8,10 +9,14 @@
 #include <optional>
 #include <vector>
 
+#include "drt/accel/bvh.h"
+#include "drt/accel/mesh.h"
+#include "drt/accel/triangle_mesh.h"
 #include "drt/geometry/plane.h"
 #include "drt/geometry/sphere.h"
 #include "drt/util/rng.h"
 #include "test_math.h"
+#include "test_meshes.h"
 
 namespace drt::testing {
 
@@ -61,6 +66,30 @@ struct World {
             if (object->intersect(ray, range)) return true;
         }
         return false;
+    }
+};
+
+// One triangle, (0, 0, 0), (4, 0, 0), (0, 4, 0), placed twice: objects[0] where it is, objects[1]
+// one unit above it (z + 1), two Mesh objects sharing one TriangleMesh, and their BVH. The ray
+// `up` meets the first at t = 3 and the second at t = 4; told to skip the first (Leaving), only
+// the second.
+struct StackedTriangles {
+    Material material;
+    std::vector<std::unique_ptr<Object>> objects = placed_twice(material);
+    Bvh bvh{objects};
+    Ray up{{1, 1, -3}, {0, 0, 1}};
+
+    static std::vector<std::unique_ptr<Object>> placed_twice(const Material& material) {
+        TestMesh flat;
+        flat.vertices = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}};
+        flat.triangles = {{0, 1, 2}};
+        const auto triangle =
+            std::make_shared<const TriangleMesh>(obj_of(flat), MeshTransform{}, false);
+        std::vector<std::unique_ptr<Object>> objects;
+        objects.push_back(std::make_unique<Mesh>(triangle, std::vector<Vec3>{Vec3{}}, material));
+        objects.push_back(
+            std::make_unique<Mesh>(triangle, std::vector<Vec3>{Vec3{0, 0, 1}}, material));
+        return objects;
     }
 };
 
