@@ -8,6 +8,7 @@
 
 #include "drt/accel/triangle_mesh.h"
 #include "drt/util/rng.h"
+#include "test_math.h"
 #include "test_meshes.h"
 
 namespace drt {
@@ -33,7 +34,7 @@ Soup soup_of(const testing::TestMesh& mesh) {
 // at the very same place: unlike a sphere's, its splits are far from the middle.
 Soup scattered(std::uint32_t n) {
     Soup s;
-    const auto unit = [](std::uint64_t key, int k) { return to_unit(hash_of(key, k)); };
+    using testing::unit;
     for (std::uint32_t i = 0; i < n; ++i) {
         const std::uint64_t key = i % 7 == 0 ? 7 : i;  // every seventh at one place
         const double size = 0.001 + 0.2 * unit(key, 0) * unit(key, 1);

@@ -381,9 +381,7 @@ TEST_F(CliTest, InfoDescribesAGoodSceneAndRejectsABadOne) {
 // ---- image files -------------------------------------------------------------------------------
 
 std::int32_t signed_le32(const std::string& s, std::size_t at) {
-    std::uint32_t v = 0;
-    for (int k = 3; k >= 0; --k) v = v << 8 | static_cast<unsigned char>(s[at + k]);
-    return static_cast<std::int32_t>(v);
+    return static_cast<std::int32_t>(testing::le32(s, at));
 }
 
 TEST_F(CliTest, PngBmpAndPfmHeadersCarryTheRequestedSize) {

@@ -8,7 +8,6 @@
 #include <memory>
 #include <vector>
 
-#include "drt/util/rng.h"
 #include "test_math.h"
 #include "test_scenes.h"
 
@@ -189,10 +188,10 @@ TEST(Plane, TextureCoordinatesAreAnIsometryOfThePlane) {
     const Vec3 at_foot = as_vec(surface_at_point(plane, foot).kd);
     EXPECT_TRUE(near(at_foot, {0, 0, 0}, 1e-12));
     for (std::uint64_t i = 0; i < 100; ++i) {
-        const Vec3 p = foot + axis_u * (200 * to_unit(hash_of(3, i)) - 100) +
-                       axis_v * (200 * to_unit(hash_of(4, i)) - 100);
-        const Vec3 q = foot + axis_u * (200 * to_unit(hash_of(5, i)) - 100) +
-                       axis_v * (200 * to_unit(hash_of(6, i)) - 100);
+        const Vec3 p = foot + axis_u * (200 * testing::unit(3, i) - 100) +
+                       axis_v * (200 * testing::unit(4, i) - 100);
+        const Vec3 q = foot + axis_u * (200 * testing::unit(5, i) - 100) +
+                       axis_v * (200 * testing::unit(6, i) - 100);
         const Vec3 tp = as_vec(surface_at_point(plane, p).kd);
         const Vec3 tq = as_vec(surface_at_point(plane, q).kd);
         EXPECT_EQ(tp.z, 0.0);

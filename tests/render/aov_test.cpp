@@ -10,7 +10,7 @@
 #include <string>
 
 #include "drt/render/renderer.h"
-#include "drt/scene/scene_loader.h"
+#include "test_render.h"
 
 namespace drt {
 namespace {
@@ -31,7 +31,7 @@ Scene floor_scene(const std::string& integrator, int samples, bool normal_down =
                             std::string(normal_down ? "-1" : "1") +
                             R"(" Vw="0" Material="Floor"/></Objects>
     </Scene>)";
-    return load_scene_from_string(xml, "test.xml").scene;
+    return testing::from_xml(xml);
 }
 
 RenderResult render_aovs(const Scene& scene, int threads = 2) {

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "drt/render/renderer.h"
+#include "test_render.h"
 #include "test_scenes.h"
 
 namespace drt {
@@ -12,15 +13,10 @@ namespace {
 
 using testing::floor_scene;
 using testing::lone_sphere_scene;
+using testing::render_with;
 
 void add_sphere_light(Scene& scene, Vec3 centre, double radius, Color intensity = {1, 1, 1}) {
     scene.lights.push_back(std::make_unique<SphereLight>(centre, radius, intensity, false));
-}
-
-RenderResult render_scene(const Scene& scene) {
-    RenderOptions options;
-    options.threads = 2;
-    return render(scene, options);
 }
 
 TEST(RenderPlan, PointLightGetsExactlyOneShadowRay) {
@@ -30,7 +26,7 @@ TEST(RenderPlan, PointLightGetsExactlyOneShadowRay) {
     const RenderPlan plan = plan_render(scene);
     EXPECT_EQ(plan.shadow_rays, std::vector<int>{1});
     EXPECT_FALSE(plan.effects.soft_shadows);
-    const RenderResult r = render_scene(scene);
+    const RenderResult r = render_with(scene);
     EXPECT_EQ(r.stats.rays.camera, 64u);
     EXPECT_EQ(r.stats.rays.shadow, 64u);
 }
@@ -44,7 +40,7 @@ TEST(RenderPlan, AreaLightsShareShadowRaysInProportionToPower) {
     const RenderPlan plan = plan_render(scene);
     EXPECT_EQ(plan.shadow_rays, (std::vector<int>{6, 2, 1}));
     EXPECT_TRUE(plan.effects.soft_shadows);
-    const RenderResult r = render_scene(scene);
+    const RenderResult r = render_with(scene);
     EXPECT_EQ(r.stats.rays.shadow, 16u * 9u);
 }
 
@@ -65,14 +61,14 @@ TEST(RenderPlan, FewerRaysThanAreaLightsPickLightsByPower) {
     EXPECT_EQ(plan.shared_rays, 1);
     ASSERT_EQ(plan.light_pick_cdf.size(), 2u);
     EXPECT_DOUBLE_EQ(plan.light_pick_cdf[0], 0.75);
-    const RenderResult r = render_scene(scene);
+    const RenderResult r = render_with(scene);
     EXPECT_EQ(r.stats.rays.shadow, 256u);
     // Unbiased: the mean equals that of the same scene with enough rays for every light.
     Scene reference = floor_scene(16, 16);
     reference.settings.shadow_rays = 64;
     add_sphere_light(reference, {0, 100, 0}, 5, {3, 3, 3});
     add_sphere_light(reference, {10, 100, 0}, 5, {1, 1, 1});
-    const RenderResult ref = render_scene(reference);
+    const RenderResult ref = render_with(reference);
     double a = 0, b = 0;
     for (int i = 0; i < 256; ++i) a += r.image.rgb[3 * i], b += ref.image.rgb[3 * i];
     EXPECT_NEAR(a / 256, b / 256, 0.01 * b / 256);
@@ -82,7 +78,7 @@ TEST(RenderPlan, SoftShadowRaysPerShadingPoint) {
     Scene scene = floor_scene(8, 8);
     scene.settings.shadow_rays = 10;
     add_sphere_light(scene, {0, 100, 0}, 5);
-    const RenderResult r = render_scene(scene);
+    const RenderResult r = render_with(scene);
     EXPECT_EQ(r.stats.rays.camera, 64u);
     EXPECT_EQ(r.stats.rays.shadow, 640u);
 }
@@ -126,10 +122,10 @@ TEST(RenderPlan, EffectsFollowTheScene) {
 TEST(RenderPlan, IdealMirrorTracesOneRayGlossyTracesGlossyRaysAtFirstHit) {
     Scene ideal = lone_sphere_scene(testing::mirror({1, 1, 1}), {1, 1, 1});
     ideal.settings.glossy_rays = 5;
-    const RenderResult r_ideal = render_scene(ideal);
+    const RenderResult r_ideal = render_with(ideal);
     Scene glossy = lone_sphere_scene(testing::mirror({1, 1, 1}, 20.0), {1, 1, 1});
     glossy.settings.glossy_rays = 5;
-    const RenderResult r_glossy = render_scene(glossy);
+    const RenderResult r_glossy = render_with(glossy);
     ASSERT_GT(r_ideal.stats.rays.reflection, 0u);
     EXPECT_EQ(r_glossy.stats.rays.reflection, 5 * r_ideal.stats.rays.reflection);
 }
@@ -151,7 +147,7 @@ Scene two_glass_floors(std::optional<double> sharpness, int glossy_rays) {
 TEST(RenderPlan, IdealGlassTracesOneRayEachWayAtEveryDepth) {
     // Depth 0: one reflection (escapes) and one refraction; depth 1: the same at the lower
     // floor; depth 2 is MaxDepth and spawns nothing. GlossyRays does not apply.
-    const RenderResult r = render_scene(two_glass_floors(std::nullopt, 5));
+    const RenderResult r = render_with(two_glass_floors(std::nullopt, 5));
     EXPECT_EQ(r.stats.rays.camera, 24u);
     EXPECT_EQ(r.stats.rays.reflection, 2u * 24);
     EXPECT_EQ(r.stats.rays.refraction, 2u * 24);
@@ -162,7 +158,7 @@ TEST(RenderPlan, IdealGlassTracesOneRayEachWayAtEveryDepth) {
 TEST(RenderPlan, BlurryGlassTracesGlossyRaysAtTheFirstHitAndOneDeeper) {
     // Depth 0: G reflections and G refractions; each refraction meets the lower floor at depth
     // 1 and spawns one of each.
-    const RenderResult r = render_scene(two_glass_floors(30.0, 3));
+    const RenderResult r = render_with(two_glass_floors(30.0, 3));
     EXPECT_EQ(r.stats.rays.reflection, (3u + 3u) * 24);
     EXPECT_EQ(r.stats.rays.refraction, (3u + 3u) * 24);
     EXPECT_TRUE(r.plan.effects.glossy_reflection && r.plan.effects.glossy_refraction);
@@ -175,7 +171,7 @@ TEST(RenderPlan, EffectsThatCannotShowAreOff) {
     Scene zero_lens = floor_scene(8, 8);
     zero_lens.lights.push_back(std::make_unique<PointLight>(Vec3{3, 40, 2}, Color{1, 1, 1}));
     zero_lens.lens = {0, 25};
-    const RenderResult a = render_scene(pinhole), b = render_scene(zero_lens);
+    const RenderResult a = render_with(pinhole), b = render_with(zero_lens);
     EXPECT_FALSE(b.plan.effects.depth_of_field);
     EXPECT_EQ(a.image.rgb, b.image.rgb);
 
@@ -183,14 +179,14 @@ TEST(RenderPlan, EffectsThatCannotShowAreOff) {
     Scene mirror_only = lone_sphere_scene(testing::mirror({1, 1, 1}), {0.5, 0.5, 0.5});
     add_sphere_light(mirror_only, {0, 10, 0}, 2);
     mirror_only.settings.shadow_rays = 8;
-    const RenderResult m = render_scene(mirror_only);
+    const RenderResult m = render_with(mirror_only);
     EXPECT_FALSE(m.plan.effects.soft_shadows);
     EXPECT_EQ(m.stats.rays.shadow, 0u);
 
     // With MaxDepth 0 no reflection is ever traced, so glossy materials are not sampled.
     Scene flat = lone_sphere_scene(testing::glass(1.5, 10.0), {1, 1, 1});
     flat.settings.max_depth = 0;
-    const RenderResult f = render_scene(flat);
+    const RenderResult f = render_with(flat);
     EXPECT_FALSE(f.plan.effects.glossy_reflection || f.plan.effects.glossy_refraction);
     EXPECT_EQ(f.stats.rays.reflection + f.stats.rays.refraction, 0u);
 }
@@ -209,7 +205,7 @@ TEST(RenderPlan, MotionAndLensAddNoRays) {
     const Material& m = *moving.materials.front();
     moving.objects.push_back(
         std::make_unique<Sphere>(std::vector<Vec3>{{0, 200, 0}, {5, 200, 0}}, 1.0, m));
-    const RenderResult a = render_scene(still), b = render_scene(moving);
+    const RenderResult a = render_with(still), b = render_with(moving);
     EXPECT_TRUE(b.plan.effects.motion_blur && b.plan.effects.depth_of_field);
     EXPECT_FALSE(a.plan.effects.motion_blur || a.plan.effects.depth_of_field);
     EXPECT_EQ(a.stats.rays.camera, 3u * 64);

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "drt/util/byte_order.h"
+
 namespace drt::testing {
 
 using Bytes = std::vector<unsigned char>;
@@ -18,16 +20,12 @@ inline void append(void* context, void* data, int size) {
 
 // The unsigned 32-bit number at `offset`, big-endian (PNG) and little-endian (BMP, EXR).
 inline std::uint32_t be32(const std::string& s, std::size_t offset) {
-    std::uint32_t v = 0;
-    for (int k = 0; k < 4; ++k) v = (v << 8) | static_cast<unsigned char>(s[offset + k]);
-    return v;
+    return static_cast<std::uint32_t>(
+        read_big_endian(reinterpret_cast<const unsigned char*>(s.data() + offset), 4));
 }
 inline std::uint32_t le32(const std::string& s, std::size_t offset) {
-    std::uint32_t v = 0;
-    for (int k = 0; k < 4; ++k) {
-        v |= std::uint32_t{static_cast<unsigned char>(s[offset + k])} << (8 * k);
-    }
-    return v;
+    return static_cast<std::uint32_t>(
+        read_little_endian(reinterpret_cast<const unsigned char*>(s.data() + offset), 4));
 }
 
 }  // namespace drt::testing
