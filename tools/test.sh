@@ -31,8 +31,8 @@ run_tests build
 # the same bits as the Release build's from another compiler, instruction set and optimisation
 # level, and the fuzz targets (docs/testing.md).
 cxx=$(command -v clang++-14 || command -v clang++)
-# A build-sanitize/ that GCC configured (an older tools/test.sh) starts afresh: CMake cannot
-# switch a build folder to another compiler.
+# A build-sanitize/ configured for another compiler starts afresh: CMake cannot switch a build
+# folder to another compiler.
 if [ -f build-sanitize/CMakeCache.txt ] &&
     ! grep -q "^CMAKE_CXX_COMPILER:.*clang" build-sanitize/CMakeCache.txt; then
     rm -rf build-sanitize
