@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <cstring>
 #include <exception>
+#include <functional>
 #include <memory>
 #include <new>
 #include <string>
@@ -137,9 +138,10 @@ struct DataWindow {
     long long width, height;
 };
 
+using Fail = std::function<ImageError(const std::string&)>;
+
 // The file's data window, refused when empty or larger than drt reads: compression lets a small
 // file claim a huge image, so this comes before any allocation.
-template <class Fail>
 DataWindow data_window(const Imf::InputFile& in, const Fail& fail) {
     const Imath::Box2i box = in.header().dataWindow();
     const long long w = static_cast<long long>(box.max.x) - box.min.x + 1;
@@ -149,23 +151,37 @@ DataWindow data_window(const Imf::InputFile& in, const Fail& fail) {
     return {box, w, h};
 }
 
-}  // namespace
-
-Image decode_exr(const Bytes& data, const fs::path& path) {
-    const auto fail = [&](const std::string& what) -> ImageError {
+// Opens `data` as an OpenEXR file whose header, data window and offset table are sound, and
+// returns what `read` makes of it; every failure, which OpenEXR reports by throwing anything
+// from a bad magic number to a truncated tile, becomes an ImageError naming `path`.
+template <class Read>
+auto read_exr(const Bytes& data, const fs::path& path, const Read& read) {
+    const Fail fail = [&](const std::string& what) {
         return ImageError(printable(path.string()) + ": " + what);
     };
-    // OpenEXR reports everything, from a bad magic number to a truncated tile, by throwing.
     try {
         if (const auto problem = exr_header_problem(data)) throw fail(*problem);
         MemoryIStream stream(data, path);
         // No worker threads: a pool costs a thread start per file and one worker gains nothing.
         Imf::InputFile in(stream, 0);
         const DataWindow window = data_window(in, fail);
-        const long long w = window.width, h = window.height;
-
         // A file cut short can still have a readable header and offset table.
         if (!in.isComplete()) throw fail("truncated OpenEXR file");
+        return read(in, window, fail);
+    } catch (const ImageError&) {
+        throw;
+    } catch (const std::bad_alloc&) {
+        throw fail("OpenEXR image too large");
+    } catch (const std::exception& e) {
+        throw fail("cannot read OpenEXR image: " + printable(e.what()));
+    }
+}
+
+}  // namespace
+
+Image decode_exr(const Bytes& data, const fs::path& path) {
+    return read_exr(data, path, [](Imf::InputFile& in, const DataWindow& window, const Fail& fail) {
+        const long long w = window.width, h = window.height;
         const Imf::ChannelList& channels = in.header().channels();
         const bool rgb =
             channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B");
@@ -195,41 +211,25 @@ Image decode_exr(const Bytes& data, const fs::path& path) {
         image.height = static_cast<int>(h);
         image.rgb.assign(pixels.get(), pixels.get() + count);
         return image;
-    } catch (const ImageError&) {
-        throw;
-    } catch (const std::bad_alloc&) {
-        throw fail("OpenEXR image too large");
-    } catch (const std::exception& e) {
-        throw fail("cannot read OpenEXR image: " + printable(e.what()));
-    }
+    });
 }
 
 std::vector<float> decode_exr_channel(const Bytes& data, const std::string& name,
                                       const fs::path& path) {
-    const auto fail = [&](const std::string& what) -> ImageError {
-        return ImageError(printable(path.string()) + ": " + what);
-    };
-    try {
-        if (const auto problem = exr_header_problem(data)) throw fail(*problem);
-        MemoryIStream stream(data, path);
-        Imf::InputFile in(stream, 0);
-        const DataWindow window = data_window(in, fail);
-        if (!in.header().channels().findChannel(name)) {
-            throw fail("OpenEXR image has no channel " + printable(name));
-        }
-        std::vector<float> values(static_cast<std::size_t>(window.width * window.height));
-        Imf::FrameBuffer frame;
-        frame.insert(name,
-                     Imf::Slice::Make(Imf::FLOAT, values.data(), window.box, sizeof(float),
-                                      sizeof(float) * static_cast<std::size_t>(window.width)));
-        in.setFrameBuffer(frame);
-        in.readPixels(window.box.min.y, window.box.max.y);
-        return values;
-    } catch (const ImageError&) {
-        throw;
-    } catch (const std::exception& e) {
-        throw fail("cannot read OpenEXR image: " + printable(e.what()));
-    }
+    return read_exr(
+        data, path, [&](Imf::InputFile& in, const DataWindow& window, const Fail& fail) {
+            if (!in.header().channels().findChannel(name)) {
+                throw fail("OpenEXR image has no channel " + printable(name));
+            }
+            std::vector<float> values(static_cast<std::size_t>(window.width * window.height));
+            Imf::FrameBuffer frame;
+            frame.insert(name,
+                         Imf::Slice::Make(Imf::FLOAT, values.data(), window.box, sizeof(float),
+                                          sizeof(float) * static_cast<std::size_t>(window.width)));
+            in.setFrameBuffer(frame);
+            in.readPixels(window.box.min.y, window.box.max.y);
+            return values;
+        });
 }
 
 }  // namespace drt

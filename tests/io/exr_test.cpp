@@ -246,6 +246,45 @@ TEST_F(ExrTest, TruncatedOrCorruptFilesThrowImageErrors) {
     }
 }
 
+// The image and a single channel are read through one opening, so they refuse a file alike: here
+// one whose writer stopped after a quarter of its rows (OpenEXR leaves the offsets of the blocks
+// it never wrote at 0).
+TEST_F(ExrTest, TheChannelReaderRefusesWhatTheImageReaderRefuses) {
+    {
+        Imf::Header header(16, 64);
+        for (const char* name : {"R", "G", "B"}) header.channels().insert(name, Imf::FLOAT);
+        std::vector<float> values(3 * 16 * 64, 0.5f);
+        Imf::FrameBuffer frame;
+        for (int c = 0; c < 3; ++c) {
+            frame.insert(c == 0 ? "R" : c == 1 ? "G" : "B",
+                         Imf::Slice::Make(Imf::FLOAT, values.data() + c, header.dataWindow(),
+                                          3 * sizeof(float), 3 * sizeof(float) * 16));
+        }
+        Imf::OutputFile out(file("part.exr").c_str(), header);
+        out.setFrameBuffer(frame);
+        out.writePixels(16);
+    }
+    const std::string part = read_bytes(file("part.exr"));
+    const std::vector<unsigned char> data(part.begin(), part.end());
+    const auto message = [](const auto& read) {
+        try {
+            read();
+        } catch (const ImageError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no exception");
+    };
+    const std::string truncated = file("part.exr").string() + ": truncated OpenEXR file";
+    EXPECT_EQ(message([&] { decode_exr(data, file("part.exr")); }), truncated);
+    EXPECT_EQ(message([&] { decode_exr_channel(data, "G", file("part.exr")); }), truncated);
+    write_image(awkward_image(16, 8), file("a.exr"));
+    const std::string bytes = read_bytes(file("a.exr"));
+    const std::vector<unsigned char> whole(bytes.begin(), bytes.end());
+    EXPECT_EQ(message([&] { decode_exr_channel(whole, "depth.Z", file("a.exr")); }),
+              file("a.exr").string() + ": OpenEXR image has no channel depth.Z");
+    EXPECT_EQ(decode_exr_channel(whole, "G", file("a.exr")).size(), 16u * 8u);
+}
+
 TEST_F(ExrTest, WritingIsAtomicLikeTheOtherFormats) {
     write_bytes(file("a.exr"), "old");
     write_image(awkward_image(), file("a.exr"));
