@@ -256,7 +256,9 @@ TEST_F(ExrTest, TheChannelReaderRefusesWhatTheImageReaderRefuses) {
         std::vector<float> values(3 * 16 * 64, 0.5f);
         Imf::FrameBuffer frame;
         for (int c = 0; c < 3; ++c) {
-            frame.insert(c == 0 ? "R" : c == 1 ? "G" : "B",
+            frame.insert(c == 0   ? "R"
+                         : c == 1 ? "G"
+                                  : "B",
                          Imf::Slice::Make(Imf::FLOAT, values.data() + c, header.dataWindow(),
                                           3 * sizeof(float), 3 * sizeof(float) * 16));
         }
