@@ -61,24 +61,22 @@ class Writer {
 class Reader {
   public:
     Reader(std::span<const unsigned char> bytes, const fs::path& file)
-        : bytes_(bytes), file_(file) {}
-    std::uint32_t u32() { return static_cast<std::uint32_t>(get(4)); }
-    std::uint64_t u64() { return get(8); }
+        : bytes_(bytes, Truncated{&file}), file_(file) {}
+    std::uint32_t u32() { return bytes_.u32(); }
+    std::uint64_t u64() { return bytes_.u64(); }
     std::string text(std::uint32_t max) {
         const std::uint32_t n = u32();
         if (n > max) fail(file_, "damaged checkpoint (bad text length)");
-        need(n);
-        std::string s(reinterpret_cast<const char*>(bytes_.data() + pos_), n);
-        pos_ += n;
-        return s;
+        const auto text = bytes_.take(n);
+        return {text.begin(), text.end()};
     }
     // A tile of `grid`, not one of those marked in `seen`, which it then marks.
     TileBuffer tile(std::span<const Tile> grid, std::vector<bool>& seen, DiffuseCount diffuse,
                     std::uint32_t aov_channels) {
-        std::span<const unsigned char> rest = bytes_.subspan(pos_);
+        std::span<const unsigned char> rest = bytes_.rest();
         try {
             TileBuffer t = take_tile(rest, grid, seen, diffuse, aov_channels);
-            pos_ = bytes_.size() - rest.size();
+            bytes_.take(left() - rest.size());
             return t;
         } catch (const TileCodecError& e) {
             if (e.problem() == TileCodecError::Problem::truncated)
@@ -86,21 +84,15 @@ class Reader {
             fail(file_, "damaged checkpoint (bad tile index)");
         }
     }
-    std::size_t left() const { return bytes_.size() - pos_; }
+    std::size_t left() const { return bytes_.rest().size(); }
 
   private:
-    void need(std::size_t n) const {
-        if (left() < n) fail(file_, "truncated checkpoint");
-    }
-    std::uint64_t get(int size) {
-        need(static_cast<std::size_t>(size));
-        const std::uint64_t v = read_little_endian(bytes_.data() + pos_, size);
-        pos_ += static_cast<std::size_t>(size);
-        return v;
-    }
-    std::span<const unsigned char> bytes_;
+    struct Truncated {
+        const fs::path* file;
+        void operator()() const { fail(*file, "truncated checkpoint"); }
+    };
+    ByteReader<Truncated> bytes_;
     const fs::path& file_;
-    std::size_t pos_ = 0;
 };
 
 // A format byte as printed: the digit, or its code when it is not one.

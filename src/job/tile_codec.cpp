@@ -34,28 +34,9 @@ class Writer {
     std::vector<unsigned char>& bytes_;
 };
 
-class Reader {
-  public:
-    explicit Reader(std::span<const unsigned char> bytes) : bytes_(bytes) {}
-    std::uint32_t u32() { return static_cast<std::uint32_t>(get(4)); }
-    std::uint64_t u64() { return get(8); }
-    float f32() { return std::bit_cast<float>(u32()); }
-    double f64() { return std::bit_cast<double>(u64()); }
-    void need(std::size_t n) const {
-        if (rest().size() < n) throw TileCodecError(TileCodecError::Problem::truncated);
-    }
-    std::span<const unsigned char> rest() const { return bytes_.subspan(pos_); }
-
-  private:
-    std::uint64_t get(int size) {
-        need(static_cast<std::size_t>(size));
-        const std::uint64_t v = read_little_endian(bytes_.data() + pos_, size);
-        pos_ += static_cast<std::size_t>(size);
-        return v;
-    }
-    std::span<const unsigned char> bytes_;
-    std::size_t pos_ = 0;
-};
+[[noreturn]] void truncated() {
+    throw TileCodecError(TileCodecError::Problem::truncated);
+}
 
 }  // namespace
 
@@ -103,7 +84,7 @@ std::vector<unsigned char> encode_tile(const TileBuffer& tile, DiffuseCount diff
 
 TileBuffer take_tile(std::span<const unsigned char>& bytes, std::span<const Tile> grid,
                      std::vector<bool>& seen, DiffuseCount diffuse, std::size_t aov_channels) {
-    Reader r(bytes);
+    ByteReader r(bytes, truncated);
     const std::uint64_t index = r.u64();
     if (index >= grid.size() || seen[index]) {
         throw TileCodecError(TileCodecError::Problem::unknown_tile);

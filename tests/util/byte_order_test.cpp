@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace drt {
@@ -28,6 +31,29 @@ TEST(ByteOrder, LittleEndianRoundTripsEveryWidth) {
         EXPECT_EQ(read_little_endian(bytes.data(), width), value & mask) << width;
         EXPECT_EQ(bytes[0], 0xef);
     }
+}
+
+TEST(ByteOrder, AReaderTakesFieldsInTurnAndCallsItsHandlerBeforeReadingPastTheEnd) {
+    std::vector<unsigned char> bytes;
+    append_little_endian(bytes, 7, 4);
+    append_little_endian(bytes, std::bit_cast<std::uint64_t>(-2.5), 8);
+    append_little_endian(bytes, std::bit_cast<std::uint32_t>(0.25f), 4);
+    bytes.insert(bytes.end(), {'a', 'b', 'c'});
+    int short_reads = 0;
+    ByteReader r(bytes, [&] {
+        ++short_reads;
+        throw std::out_of_range("short");
+    });
+    EXPECT_EQ(r.u32(), 7u);
+    EXPECT_EQ(r.f64(), -2.5);
+    EXPECT_EQ(r.f32(), 0.25f);
+    EXPECT_EQ(r.rest().size(), 3u);
+    EXPECT_THROW(r.u32(), std::out_of_range);  // three bytes left: nothing is read
+    EXPECT_EQ(short_reads, 1);
+    const auto text = r.take(3);
+    EXPECT_EQ(std::string(text.begin(), text.end()), "abc");
+    EXPECT_THROW(r.take(1), std::out_of_range);
+    EXPECT_EQ(short_reads, 2);
 }
 
 }  // namespace
