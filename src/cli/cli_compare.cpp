@@ -38,12 +38,15 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
     try {
         // Check every name before reading, so a typo costs nothing and writes nothing.
         const bool linear_a = is_linear(format_for_path(a));
-        if (linear_a != is_linear(format_for_path(b))) {
-            // Linear floats against sRGB-encoded bytes would measure the tone curve, not the image.
-            throw ImageError("cannot compare " + printable(linear_a ? a : b) + " (linear) with " +
-                             printable(linear_a ? b : a) + " (8-bit sRGB): convert one first");
-        }
+        const bool linear_b = is_linear(format_for_path(b));
         if (!diff.empty()) format_for_path(diff);
+        if (linear_a != linear_b) {
+            // The measures are of the stored values, as always; said because linear floats
+            // against sRGB-encoded bytes then measure the tone curve as much as the image.
+            err << "drt compare: warning: " << printable(linear_a ? a : b)
+                << " holds linear values and " << printable(linear_a ? b : a)
+                << " sRGB-encoded 8-bit ones: the measures include the tone curve\n";
+        }
         image_a = read_image(a);
         image_b = read_image(b);
         c = compare_images(image_a, image_b);

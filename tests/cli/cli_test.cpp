@@ -23,6 +23,7 @@
 #include <variant>
 #include <vector>
 
+#include "drt/io/compare.h"
 #include "drt/io/image.h"
 #include "encoded_bytes.h"
 #include "regex_match.h"
@@ -637,17 +638,16 @@ TEST_F(CompareCliTest, DifferentImagesPrintTheirErrorAndFailOnlyBeyondTolerance)
     EXPECT_EQ(run({"compare", "quarter.pfm", "half.pfm", "--min-psnr", "12.1"}).status, 1);
 }
 
-TEST_F(CompareCliTest, SizeMismatchUnreadableAndMixedFormatsExitTwo) {
+TEST_F(CompareCliTest, SizeMismatchAndUnreadableFilesExitTwo) {
     const Outcome size = run({"compare", "quarter.pfm", "wide.pfm", "--diff", "d.png"});
     EXPECT_EQ(size.status, 2);
     EXPECT_NE(size.err.find("4x3 vs 5x3"), std::string::npos) << size.err;
     write_bytes(file("garbage.png"), "not a png at all");
     write_image(constant(4, 3, 0.25f), file("quarter.png"));
-    for (const auto& [a, b] : std::vector<std::pair<std::string, std::string>>{
-             {"quarter.pfm", "missing.pfm"},
-             {"garbage.png", "quarter.png"},
-             {"quarter.pfm", "quarter.png"},  // linear floats against sRGB bytes
-             {"quarter.pfm", "notes.txt"}}) {
+    for (const auto& [a, b] :
+         std::vector<std::pair<std::string, std::string>>{{"quarter.pfm", "missing.pfm"},
+                                                          {"garbage.png", "quarter.png"},
+                                                          {"quarter.pfm", "notes.txt"}}) {
         const Outcome r = run({"compare", a, b, "--diff", "d.png"});
         EXPECT_EQ(r.status, 2) << a << " " << b;
         EXPECT_NE(r.err.find(a == "garbage.png" ? a : b), std::string::npos) << r.err;
@@ -792,7 +792,7 @@ TEST_F(CliTest, AovsAreExtraExrChannelsAndOtherOutputsAreRefused) {
     }
 }
 
-TEST_F(CompareCliTest, ExrComparesWithPfmButNotWithEightBitFiles) {
+TEST_F(CompareCliTest, ExrComparesWithPfmAndWithEightBitFilesByTheirStoredValues) {
     write_image(constant(4, 3, 0.25f), file("quarter.exr"));
     const Outcome same = run({"compare", "quarter.exr", "quarter.pfm", "--max-rmse", "0"});
     EXPECT_EQ(same.status, 0) << same.err;
@@ -801,12 +801,16 @@ TEST_F(CompareCliTest, ExrComparesWithPfmButNotWithEightBitFiles) {
     EXPECT_EQ(differ.out.rfind("rmse=0.25 psnr=12.0412 ", 0), 0u) << differ.out;
     EXPECT_EQ(read_image(file("d.exr")).width, 4);
 
+    // Linear against 8-bit: the stored values, as the contract measures them (0.25 against the
+    // sRGB code of 0.25, 137, as 137/255), with a warning that the tone curve is in them.
     write_image(constant(4, 3, 0.25f), file("quarter.png"));
-    const Outcome mixed = run({"compare", "quarter.exr", "quarter.png"});
-    EXPECT_EQ(mixed.status, 2);
-    EXPECT_NE(mixed.err.find("cannot compare quarter.exr (linear) with quarter.png (8-bit sRGB)"),
-              std::string::npos)
-        << mixed.err;
+    const Outcome mixed = run({"compare", "quarter.exr", "quarter.png", "--max-rmse", "0.3"});
+    EXPECT_EQ(mixed.status, 0) << mixed.err;
+    EXPECT_EQ(mixed.out.rfind("rmse=" + format_measure(137.0 / 255 - 0.25) + " ", 0), 0u)
+        << mixed.out;
+    EXPECT_EQ(mixed.err,
+              "drt compare: warning: quarter.exr holds linear values and quarter.png "
+              "sRGB-encoded 8-bit ones: the measures include the tone curve\n");
 }
 
 TEST_F(CompareCliTest, CorruptOrTruncatedExrExitsTwoNamingTheFile) {
