@@ -1,5 +1,6 @@
 #include "drt/geometry/motion.h"
 
+#include <algorithm>
 #include <utility>
 
 namespace drt {
@@ -9,6 +10,12 @@ MotionPath::MotionPath(std::vector<Vec3> points) : points_(std::move(points)) {}
 Vec3 MotionPath::moving_at(double time) const {
     if (time >= end()) return points_.back();
     return segment(static_cast<std::size_t>(time)).at(time);
+}
+
+bool MotionPath::travels() const {
+    return std::ranges::any_of(points_, [&](const Vec3& p) {
+        return p.x != points_[0].x || p.y != points_[0].y || p.z != points_[0].z;
+    });
 }
 
 Interval MotionPath::segment_time(std::size_t k) const {

@@ -11,8 +11,16 @@ Camera Scene::camera() const {
 
 double Scene::shutter_end() const {
     double end = 0;
-    for (const auto& object : objects) end = std::max(end, object->motion_end());
-    return end;
+    bool travels = false;
+    for (const auto& object : objects) {
+        end = std::max(end, object->motion_end());
+        const Shapes shapes = object->shapes();
+        for (const SphereShape& s : shapes.spheres) travels = travels || s.path->travels();
+        for (const MeshShape& m : shapes.meshes) travels = travels || m.path->travels();
+    }
+    // Paths that all stay in one place blur nothing, so no shutter time is drawn; where anything
+    // moves, the longest path sets the shutter, a still one included.
+    return travels ? end : 0;
 }
 
 const Material* Scene::find_material(const std::string& name) const {

@@ -119,6 +119,29 @@ TEST(RenderPlan, EffectsFollowTheScene) {
     EXPECT_EQ(plan.shutter_end, 2.0);
 }
 
+// MotionBlurPosition children at the object's own place move nothing: no shutter, no time drawn,
+// the same image as without them. Beside a moving object, the still path's length still sets
+// the shutter, as it always has.
+TEST(RenderPlan, APathThatStaysInOnePlaceBlursNothing) {
+    Scene still = floor_scene(8, 8);
+    const Material& m = *still.materials.front();
+    still.objects.push_back(
+        std::make_unique<Sphere>(std::vector<Vec3>{{0, 5, 0}, {0, 5, 0}, {0, 5, 0}}, 1.0, m));
+    const RenderPlan plan = plan_render(still);
+    EXPECT_FALSE(plan.effects.motion_blur);
+    EXPECT_EQ(plan.shutter_end, 0.0);
+
+    Scene plain = floor_scene(8, 8);
+    plain.objects.push_back(std::make_unique<Sphere>(std::vector<Vec3>{{0, 5, 0}}, 1.0, m));
+    EXPECT_EQ(render_with(still).image.rgb, render_with(plain).image.rgb);
+
+    still.objects.push_back(
+        std::make_unique<Sphere>(std::vector<Vec3>{{3, 5, 0}, {4, 5, 0}}, 1.0, m));
+    const RenderPlan mixed = plan_render(still);
+    EXPECT_TRUE(mixed.effects.motion_blur);
+    EXPECT_EQ(mixed.shutter_end, 2.0);
+}
+
 TEST(RenderPlan, IdealMirrorTracesOneRayGlossyTracesGlossyRaysAtFirstHit) {
     Scene ideal = lone_sphere_scene(testing::mirror({1, 1, 1}), {1, 1, 1});
     ideal.settings.glossy_rays = 5;

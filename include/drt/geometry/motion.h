@@ -38,6 +38,8 @@ class MotionPath {
     // Time at which the path ends; 0 for a path that stays put.
     double end() const { return static_cast<double>(points_.size() - 1); }
     bool moves() const { return points_.size() > 1; }
+    // Whether it goes anywhere: a path of several points may repeat one place throughout.
+    bool travels() const;
 
     std::size_t segment_count() const { return points_.size() - 1; }
     PathSegment segment(std::size_t k) const {

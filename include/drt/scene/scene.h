@@ -74,7 +74,8 @@ struct Scene {
 
     // The camera for the current settings (the default camera depends on the image size).
     Camera camera() const;
-    // Shutter times run over [0, shutter_end()]: the longest motion path in segments.
+    // Shutter times run over [0, shutter_end()]: the longest motion path in segments; 0 when no
+    // path goes anywhere.
     double shutter_end() const;
     const Material* find_material(const std::string& name) const;
 };
