@@ -73,9 +73,6 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
     const RayCounts& rays = r.stats.rays;
     const Effects& e = r.plan.effects;
     const RenderSettings& s = scene.settings;
-    // The path integrator's keys appear only in its renders: a distributed render's JSON is as it
-    // was before that integrator existed.
-    const bool path = s.integrator == IntegratorKind::kPath;
     std::ostringstream j;
     j << std::setprecision(6);
     j << "{\n  \"scene\": " << json_string(scene.path) << ",\n"
@@ -96,7 +93,7 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
     }
     j << "  \"rays\": {\"camera\": " << rays.camera << ", \"shadow\": " << rays.shadow
       << ", \"reflection\": " << rays.reflection << ", \"refraction\": " << rays.refraction;
-    if (path) j << ", \"diffuse\": " << rays.diffuse;
+    j << ", \"diffuse\": " << rays.diffuse;
     j << ", \"total\": " << rays.total() << "},\n"
       << "  \"million_rays_per_second\": "
       << json_number(r.stats.seconds > 0 ? rays.total() / r.stats.seconds / 1e6 : 0.0) << ",\n"
@@ -126,7 +123,7 @@ std::string stats_json(const Scene& scene, const RenderResult& r, const std::str
       << ", \"glossy_refraction\": " << json_bool(e.glossy_refraction)
       << ", \"depth_of_field\": " << json_bool(e.depth_of_field)
       << ", \"motion_blur\": " << json_bool(e.motion_blur);
-    if (path) j << ", \"indirect_light\": " << json_bool(e.indirect_light);
+    j << ", \"indirect_light\": " << json_bool(e.indirect_light);
     if (s.photons) j << ", \"caustics\": " << json_bool(e.caustics);
     j << "}\n}";
     return j.str();

@@ -116,10 +116,10 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
         << "glossy rays: " << s.glossy_rays << "\n"
         << "seed: " << s.seed << "\n"
         << "sampler: " << s.sampler << "\n";
-    // A distributed scene without emitting surfaces is described as before the path integrator
-    // and emitters existed.
     const bool path = s.integrator == IntegratorKind::kPath;
-    if (path) out << "integrator: path (unbiased path tracing)\n";
+    out << "integrator: "
+        << (path ? "path (unbiased path tracing)" : "distributed (Cook's distributed ray tracing)")
+        << "\n";
     out << "camera: " << (scene.view ? "look-at" : "thesis pixel plane")
         << (scene.lens.is_pinhole() ? ", pinhole" : ", thin lens") << "\n"
         << "materials: " << scene.materials.size() << "\n"
@@ -135,9 +135,7 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
         const Shapes shapes = object->shapes();
         emitting_planes += object->material().emits() ? shapes.planes.size() : 0;
     }
-    if (path || plan.emitters.size() > 0 || emitting_planes > 0) {
-        out << "emitters: " << plan.emitters.size() << "\n";
-    }
+    out << "emitters: " << plan.emitters.size() << "\n";
     for (std::size_t i = 0; i < plan.emitters.size(); ++i) {
         const Emitters::Emitter& e = plan.emitters[i];
         out << "  emitter " << i << ": ";
@@ -177,7 +175,7 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
         << "  motion_blur: " << flag(e.motion_blur);
     if (e.motion_blur) out << " (shutter 0.." << plan.shutter_end << ")";
     out << "\n";
-    if (path) out << "  indirect_light: " << flag(e.indirect_light) << "\n";
+    out << "  indirect_light: " << flag(e.indirect_light) << "\n";
     if (s.photons) {
         out << "  caustics: " << flag(e.caustics);
         if (e.caustics) {

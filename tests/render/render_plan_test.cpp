@@ -243,6 +243,14 @@ TEST(RenderPlan, DescribeNamesTheSampledEffects) {
     const std::string text = describe(scene, plan_render(scene));
     EXPECT_NE(text.find("depth_of_field: sampled"), std::string::npos);
     EXPECT_NE(text.find("motion_blur: off"), std::string::npos);
+    // Which integrator, and what it leaves out, whichever it is.
+    EXPECT_NE(text.find("integrator: distributed"), std::string::npos) << text;
+    EXPECT_NE(text.find("indirect_light: off"), std::string::npos) << text;
+    EXPECT_NE(text.find("emitters: 0"), std::string::npos) << text;
+    scene.settings.integrator = IntegratorKind::kPath;
+    const std::string path = describe(scene, plan_render(scene));
+    EXPECT_NE(path.find("integrator: path"), std::string::npos) << path;
+    EXPECT_NE(path.find("indirect_light: sampled"), std::string::npos) << path;
 }
 
 }  // namespace
