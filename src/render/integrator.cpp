@@ -61,13 +61,15 @@ Vec3 perturb_direction(const Vec3& ideal, double sigma, Vec2 u) {
 }
 
 Integrator::Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bvh,
-                       const Sampler& sampler, const PhotonMaps* photons)
+                       const Sampler& sampler, const PhotonMaps* photons,
+                       std::uint64_t whole_tree_rays)
     : scene_(scene),
       plan_(plan),
       bvh_(bvh),
       sampler_(sampler),
       photons_(photons),
-      camera_(scene.camera()) {
+      camera_(scene.camera()),
+      whole_tree_rays_(whole_tree_rays) {
     for (const auto& light : scene.lights) {
         any_visible_light_ = any_visible_light_ || light->visible();
         if (!light->is_point()) area_lights_.push_back(light.get());
@@ -76,23 +78,24 @@ Integrator::Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bv
 
 void Integrator::sample_pixel(int x, int y, const PixelSample& s, std::span<Color> out,
                               RayCounts& counts) const {
-    PixelWork work{counts, RunPoints(sampler_, s, static_cast<std::uint32_t>(out.size()))};
+    PixelWork work{counts, RunPoints(sampler_, s, static_cast<std::uint32_t>(out.size())), 0};
     const CameraRays rays(camera_, sampler_, plan_, x, y, s, out.size());
     PixelSample sample = s;
     for (std::size_t i = 0; i < out.size(); ++i, ++sample.index) {
         ++counts.camera;
+        work.tree_rays = 0;
         out[i] = radiance(rays.at(i, sample), sample, 0, work);
     }
 }
 
 Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth,
                            RayCounts& counts) const {
-    PixelWork work{counts, RunPoints(sampler_, s, 0)};
+    PixelWork work{counts, RunPoints(sampler_, s, 0), 0};
     return radiance(ray, s, depth, work);
 }
 
 Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, PixelWork& work,
-                           Leaving leaving) const {
+                           Leaving leaving, double throughput) const {
     const auto hit = bvh_.intersect(ray, {0, kInfinity}, leaving);
     if (any_visible_light_) {
         double nearest = hit ? hit->t : kInfinity;
@@ -126,33 +129,40 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
 
     // The plan says whether directions are perturbed at all, the material by how much.
     const Effects& e = plan_.effects;
+    const Facing at{surface.point, geometric, shading};
+    if (work.tree_rays >= whole_tree_rays_) {
+        return result + one_branch(ray, s, depth, work, m, at, outside, from_hit, throughput);
+    }
     if (m.reflects()) {
-        const double reflection_sigma = e.glossy_reflection ? m.sigma() : 0.0;
-        const Vec3 ideal = reflect_above(ray.dir, shading, geometric);
-        result += m.reflective * m.ks *
-                  scattered(surface.point, geometric, from_hit, ideal, reflection_sigma, +1,
-                            ray.time, s, depth, dim::kGlossReflect, false, work);
+        const Color weight = m.reflective * m.ks;
+        const Scatter reflection{reflect_above(ray.dir, shading, geometric),
+                                 e.glossy_reflection ? m.sigma() : 0.0, +1, dim::kGlossReflect,
+                                 false};
+        result += weight * scattered(at, from_hit, reflection, throughput * max_component(weight),
+                                     ray.time, s, depth, work);
     }
     if (m.transmits()) {
         const double sigma = m.sigma();
-        const double reflection_sigma = e.glossy_reflection ? sigma : 0.0;
-        const double refraction_sigma = e.glossy_refraction ? sigma : 0.0;
         // The medium outside every object is air (index 1), as in the thesis.
         const double eta = outside ? 1.0 / m.index : m.index;
         const double cos_i = std::max(0.0, -dot(ray.dir, shading));
         const double fresnel = fresnel_dielectric(cos_i, eta);
+        const double weight = throughput * max_component(m.transmit * m.kt);
         Color glass;
         if (fresnel > 0) {
-            glass +=
-                fresnel * scattered(surface.point, geometric, from_hit,
-                                    reflect_above(ray.dir, shading, geometric), reflection_sigma,
-                                    +1, ray.time, s, depth, dim::kGlassReflect, false, work);
+            const Scatter reflection{reflect_above(ray.dir, shading, geometric),
+                                     e.glossy_reflection ? sigma : 0.0, +1, dim::kGlassReflect,
+                                     false};
+            glass += fresnel * scattered(at, from_hit, reflection, weight * fresnel, ray.time, s,
+                                         depth, work);
         }
         if (fresnel < 1) {
             if (const auto through = refract_below(ray.dir, shading, geometric, eta)) {
-                glass += (1.0 - fresnel) * scattered(surface.point, geometric, from_hit, *through,
-                                                     refraction_sigma, -1, ray.time, s, depth,
-                                                     dim::kGlossRefract, true, work);
+                const Scatter refraction{*through, e.glossy_refraction ? sigma : 0.0, -1,
+                                         dim::kGlossRefract, true};
+                glass +=
+                    (1.0 - fresnel) * scattered(at, from_hit, refraction, weight * (1.0 - fresnel),
+                                                ray.time, s, depth, work);
             }
         }
         result += m.transmit * m.kt * glass;
@@ -160,23 +170,82 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
     return result;
 }
 
-Color Integrator::scattered(const Vec3& point, const Vec3& geometric, Leaving leaving,
-                            const Vec3& ideal, double sigma, double side, double time,
-                            const PixelSample& s, int depth, std::uint32_t kind, bool refraction,
+Color Integrator::one_branch(const Ray& ray, const PixelSample& s, int depth, PixelWork& work,
+                             const Material& m, const Facing& at, bool outside, Leaving leaving,
+                             double throughput) const {
+    const Vec3& geometric = at.geometric;
+    const Vec3& shading = at.shading;
+    const Effects& e = plan_.effects;
+    const double sigma = m.sigma();
+    // The rays the whole tree would trace here, as radiance() does, each with its weight.
+    std::array<std::pair<Color, Scatter>, 3> branches;
+    int count = 0;
+    if (m.reflects()) {
+        branches[count++] = {m.reflective * m.ks,
+                             {reflect_above(ray.dir, shading, geometric),
+                              e.glossy_reflection ? sigma : 0.0, +1, dim::kGlossReflect, false}};
+    }
+    if (m.transmits()) {
+        const double eta = outside ? 1.0 / m.index : m.index;
+        const double fresnel = fresnel_dielectric(std::max(0.0, -dot(ray.dir, shading)), eta);
+        const Color glass = m.transmit * m.kt;
+        if (fresnel > 0) {
+            branches[count++] = {
+                glass * fresnel,
+                {reflect_above(ray.dir, shading, geometric), e.glossy_reflection ? sigma : 0.0, +1,
+                 dim::kGlassReflect, false}};
+        }
+        if (const auto through = refract_below(ray.dir, shading, geometric, eta);
+            fresnel < 1 && through) {
+            branches[count++] = {
+                glass * (1.0 - fresnel),
+                {*through, e.glossy_refraction ? sigma : 0.0, -1, dim::kGlossRefract, true}};
+        }
+    }
+    double total = 0;
+    for (int i = 0; i < count; ++i) total += max_component(branches[i].first);
+    if (!(total > 0)) return {};
+    // Not a sampler dimension: past the bound is rare, and a hash of where in the tree the
+    // pick is keeps it a pure function of (seed, pixel, sample, branch).
+    constexpr std::uint64_t kPickSalt = 0x7472656570696b;
+    double u = to_unit(hash_of(s.seed, s.pixel, s.index, s.path, depth, kPickSalt)) * total;
+    int pick = 0;
+    for (; pick + 1 < count && u >= max_component(branches[pick].first); ++pick) {
+        u -= max_component(branches[pick].first);
+    }
+    const auto& [weight, how] = branches[pick];
+    const double odds = max_component(weight) / total;
+    return weight / odds *
+           scattered(at, leaving, how, throughput * total, ray.time, s, depth, work);
+}
+
+Color Integrator::scattered(const Facing& at, Leaving leaving, const Scatter& how,
+                            double throughput, double time, const PixelSample& s, int depth,
                             PixelWork& work) const {
-    const std::uint32_t dimension = dim::bounce(depth, kind);
-    const int rays = sigma > 0 && depth == 0 ? scene_.settings.glossy_rays : 1;
+    const std::uint32_t dimension = dim::bounce(depth, how.kind);
+    const int rays = how.sigma > 0 && depth == 0 ? scene_.settings.glossy_rays : 1;
     Color sum;
     for (int j = 0; j < rays; ++j) {
-        Vec3 dir = ideal;
-        if (sigma > 0) {
+        // Past the bound every ray, a pending sibling's too, survives Russian roulette with its
+        // throughput as the odds and is divided by them: a tree whose weights add up to at most 1
+        // at each hit then traces about one chain of rays, whatever MaxDepth is.
+        double survival = 1;
+        if (work.tree_rays >= whole_tree_rays_ && throughput < 1) {
+            constexpr std::uint64_t kRouletteSalt = 0x726f756c65747465;
+            survival = throughput;
+            const std::uint64_t h =
+                hash_of(s.seed, s.pixel, s.index, dimension, s.path, j, kRouletteSalt);
+            if (to_unit(h) >= survival) continue;
+        }
+        Vec3 dir = how.ideal;
+        if (how.sigma > 0) {
             Vec2 u = rays == 1 ? work.points.get_2d(s, dimension)
                                : sampler_.get_2d_in_set(s, dimension, j, rays);
             for (int attempt = 1;; ++attempt) {
-                dir = perturb_direction(ideal, sigma, u);
-                if (side * dot(dir, geometric) > 0) break;
+                dir = perturb_direction(how.ideal, how.sigma, u);
+                if (how.side * dot(dir, at.geometric) > 0) break;
                 if (attempt == kRedrawAttempts) {
-                    dir = ideal;
+                    dir = how.ideal;
                     break;
                 }
                 const std::uint64_t h =
@@ -184,9 +253,12 @@ Color Integrator::scattered(const Vec3& point, const Vec3& geometric, Leaving le
                 u = {to_unit(h), to_unit(mix64(h))};
             }
         }
-        ++(refraction ? work.counts.refraction : work.counts.reflection);
-        sum += radiance(spawn_ray(point, geometric, dir, time), s.branch(kind, j), depth + 1, work,
-                        leaving);
+        ++(how.refraction ? work.counts.refraction : work.counts.reflection);
+        ++work.tree_rays;
+        const Color light =
+            radiance(spawn_ray(at.point, at.geometric, dir, time), s.branch(how.kind, j), depth + 1,
+                     work, leaving, throughput / survival);
+        sum += survival == 1 ? light : light / survival;
     }
     return rays == 1 ? sum : sum / rays;
 }

@@ -41,10 +41,6 @@ double power_heuristic(double own, double other) {
     return 1 / (1 + r * r);
 }
 
-double max_component(const Color& c) {
-    return std::max({c.r, c.g, c.b});
-}
-
 // A direction about unit `n` with density cos θ / π.
 Vec3 cosine_direction(const Vec3& n, Vec2 u) {
     const double r = std::sqrt(u.x);

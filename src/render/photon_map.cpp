@@ -32,10 +32,6 @@ double unit(std::uint64_t key, std::uint32_t j) {
     return to_unit(hash_combine(key, j));
 }
 
-double max_component(const Color& c) {
-    return std::max({c.r, c.g, c.b});
-}
-
 // As the integrators perturb a direction: redrawn until it leaves on the `side` of the surface.
 Vec3 perturbed(const Vec3& ideal, double sigma, double side, const Vec3& geometric,
                std::uint64_t key, std::uint32_t dimension) {

@@ -75,11 +75,20 @@ std::optional<Vec3> refract_below(const Vec3& d, const Vec3& shading, const Vec3
 // read the finest level.
 SurfaceHit surface_of(const Ray& ray, const Hit& hit, int depth, const Camera& camera, int samples);
 
+// A camera sample's ray tree is traced whole up to this many reflected and refracted rays. Past
+// them a new hit follows one of its rays, picked in proportion to its weight, and every ray
+// survives Russian roulette by its throughput (both divided by their odds: unbiased). Glass
+// between mirrors doubles the tree at each bounce, 2^MaxDepth rays a sample, which no render
+// could trace at MaxDepth 512; the trees of the repository's scenes stay below the bound, so
+// they render as they did before it.
+inline constexpr std::uint64_t kWholeTreeRays = 4096;
+
 class Integrator final : public PixelIntegrator {
   public:
     // With `photons`, diffuse parts add the caustic light the photon maps estimate.
+    // `whole_tree_rays`: the bound above (tests set others).
     Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bvh, const Sampler& sampler,
-               const PhotonMaps* photons = nullptr);
+               const PhotonMaps* photons = nullptr, std::uint64_t whole_tree_rays = kWholeTreeRays);
 
     // Camera samples s.index, s.index + 1, ... of pixel (x, y): the radiance along each camera
     // ray, into out. A run of a pixel's samples shares the work of drawing their camera points.
@@ -93,12 +102,15 @@ class Integrator final : public PixelIntegrator {
     // What the paths of one run of a pixel's samples share.
     struct PixelWork {
         RayCounts& counts;
-        RunPoints points;  // of the glossy dimensions
+        RunPoints points;         // of the glossy dimensions
+        std::uint64_t tree_rays;  // reflected and refracted rays of the current camera sample
     };
 
-    // `leaving`: the triangle the ray leaves from, which it skips (bvh.h).
+    // `leaving`: the triangle the ray leaves from, which it skips (bvh.h); `throughput`: the
+    // largest channel of the product of the weights from the camera to this ray, which only a
+    // tree past kWholeTreeRays reads.
     Color radiance(const Ray& ray, const PixelSample& s, int depth, PixelWork& work,
-                   Leaving leaving = {}) const;
+                   Leaving leaving = {}, double throughput = 1) const;
     // Σ lights at a point: I · max(0, N·ω) · visibility, averaged over each light's shadow rays,
     // which skip the triangle `leaving`.
     Color direct_light(const Vec3& point, const Vec3& geometric, const Vec3& shading,
@@ -113,12 +125,30 @@ class Integrator final : public PixelIntegrator {
     Color emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point, const Vec3& origin,
                       Leaving leaving, const Vec3& geometric, const Vec3& shading, double time,
                       RayCounts& counts) const;
-    // Average radiance along `rays` directions about `ideal` (one exactly ideal ray if sigma is
-    // 0), each redrawn until it leaves on the `side` of the surface (+1 = the normal's side),
-    // skipping the triangle `leaving`.
-    Color scattered(const Vec3& point, const Vec3& geometric, Leaving leaving, const Vec3& ideal,
-                    double sigma, double side, double time, const PixelSample& s, int depth,
-                    std::uint32_t kind, bool refraction, PixelWork& work) const;
+    // A hit's point and its normals facing the ray that arrived (facing_normals).
+    struct Facing {
+        Vec3 point, geometric, shading;
+    };
+    // A reflected or refracted ray to trace from a hit: its ideal direction, perturbed by `sigma`
+    // (0: exactly ideal) and redrawn until it leaves on the `side` of the surface (+1: the
+    // normal's), and its sampler dimension's `kind`.
+    struct Scatter {
+        Vec3 ideal;
+        double sigma;
+        double side;
+        std::uint32_t kind;
+        bool refraction;
+    };
+    // The reflected and refracted light of material m at a hit along one of the rays the whole
+    // tree would trace there, picked in proportion to its weight (past kWholeTreeRays);
+    // `outside`: the ray arrived from outside the surface; `leaving`: the hit's triangle.
+    Color one_branch(const Ray& ray, const PixelSample& s, int depth, PixelWork& work,
+                     const Material& m, const Facing& at, bool outside, Leaving leaving,
+                     double throughput) const;
+    // Average radiance along the scattered rays of `how` (GlossyRays of them for a perturbed
+    // direction at the first hit, else one), skipping the triangle `leaving`.
+    Color scattered(const Facing& at, Leaving leaving, const Scatter& how, double throughput,
+                    double time, const PixelSample& s, int depth, PixelWork& work) const;
 
     const Scene& scene_;
     const RenderPlan& plan_;
@@ -128,6 +158,7 @@ class Integrator final : public PixelIntegrator {
     Camera camera_;
     std::vector<const Light*> area_lights_;  // in scene order, as plan_.light_pick_cdf
     bool any_visible_light_ = false;
+    std::uint64_t whole_tree_rays_;
 };
 
 }  // namespace drt

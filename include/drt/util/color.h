@@ -49,6 +49,9 @@ constexpr Color lerp(const Color& a, const Color& b, double t) {
 constexpr double luminance(const Color& c) {
     return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
 }
+constexpr double max_component(const Color& c) {
+    return std::max({c.r, c.g, c.b});
+}
 constexpr bool is_black(const Color& c) {
     return c.r == 0 && c.g == 0 && c.b == 0;
 }
