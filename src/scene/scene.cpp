@@ -9,18 +9,22 @@ Camera Scene::camera() const {
     return Camera::thesis_default(settings.width, settings.height, lens, settings.pixel_plane_unit);
 }
 
+bool travels(const Object& object) {
+    const Shapes shapes = object.shapes();
+    return std::ranges::any_of(shapes.spheres, [](const auto& s) { return s.path->travels(); }) ||
+           std::ranges::any_of(shapes.meshes, [](const auto& m) { return m.path->travels(); });
+}
+
 double Scene::shutter_end() const {
     double end = 0;
-    bool travels = false;
+    bool any_travels = false;
     for (const auto& object : objects) {
         end = std::max(end, object->motion_end());
-        const Shapes shapes = object->shapes();
-        for (const SphereShape& s : shapes.spheres) travels = travels || s.path->travels();
-        for (const MeshShape& m : shapes.meshes) travels = travels || m.path->travels();
+        any_travels = any_travels || travels(*object);
     }
     // Paths that all stay in one place blur nothing, so no shutter time is drawn; where anything
     // moves, the longest path sets the shutter, a still one included.
-    return travels ? end : 0;
+    return any_travels ? end : 0;
 }
 
 const Material* Scene::find_material(const std::string& name) const {

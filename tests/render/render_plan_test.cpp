@@ -130,6 +130,7 @@ TEST(RenderPlan, APathThatStaysInOnePlaceBlursNothing) {
     const RenderPlan plan = plan_render(still);
     EXPECT_FALSE(plan.effects.motion_blur);
     EXPECT_EQ(plan.shutter_end, 0.0);
+    EXPECT_NE(describe(still, plan).find("(0 moving)"), std::string::npos);
 
     Scene plain = floor_scene(8, 8);
     plain.objects.push_back(std::make_unique<Sphere>(std::vector<Vec3>{{0, 5, 0}}, 1.0, m));
