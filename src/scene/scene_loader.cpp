@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <optional>
 #include <span>
@@ -238,6 +239,16 @@ class Attributes {
     void check(bool ok, std::string_view name, std::string_view rule) const {
         if (!ok) fail(std::string(name) + " must be " + std::string(rule) + ", got " + shown(name));
     }
+    // A radiance that rays see as it is must fit the float channels of an image.
+    void check_radiance(const Color& c, std::string_view r, std::string_view g,
+                        std::string_view b) const {
+        for (const auto& [value, name] : {std::pair{c.r, r}, {c.g, g}, {c.b, b}}) {
+            check(std::abs(value) <= kLargestPixelValue, name, kLargestPixelValueText);
+        }
+    }
+    static constexpr double kLargestPixelValue = std::numeric_limits<float>::max();
+    static constexpr std::string_view kLargestPixelValueText =
+        "at most 3.40282e+38 (the largest value a float image holds)";
     // The attribute's value as the user wrote it, for messages.
     std::string shown(std::string_view name) const {
         const char* value = element_.Attribute(std::string(name).c_str());
@@ -681,6 +692,7 @@ class SceneReader {
     Color read_rgb(const XMLElement& e) {
         Attributes in(e, context_);
         const Color c = in.color("r", "g", "b", {0, 0, 0});
+        in.check_radiance(c, "r", "g", "b");
         in.warn_unknown();
         warn_children(e);
         return c;
@@ -743,6 +755,7 @@ class SceneReader {
         in.check(m->emission.r >= 0, "ker", "non-negative");
         in.check(m->emission.g >= 0, "keg", "non-negative");
         in.check(m->emission.b >= 0, "keb", "non-negative");
+        in.check_radiance(m->emission, "ker", "keg", "keb");
         in.check(m->index > 0, "index", "positive");
         if (const auto n = in.optional_number("n")) {
             in.check(*n > 0, "n", "positive");
@@ -788,6 +801,11 @@ class SceneReader {
             auto material = std::make_unique<Material>();
             material->name = "(Falloff 1 light on line " + std::to_string(e.GetLineNum()) + ")";
             material->emission = intensity * (1.0 / (radius * radius));
+            if (!(max_component(material->emission) <= Attributes::kLargestPixelValue)) {
+                in.fail("a Falloff 1 light of radius " + in.shown("Radius") +
+                        " is seen with radiance I/Radius^2 past the largest value a float "
+                        "image holds (3.40282e+38)");
+            }
             emitting_lights_.push_back({position, radius, std::move(material)});
         } else if (radius == 0) {
             if (visible)
