@@ -1225,6 +1225,23 @@ TEST(SceneLoaderLightTransport, EmissionIsReadAndMustNotBeNegative) {
               "t.xml:2: Glow: keg must be non-negative, got -1");
 }
 
+// Radiance that a ray sees as it is must fit an image's floats: refused at its line, not found
+// in the finished image.
+TEST(SceneLoaderLightTransport, RadianceSeenDirectlyMustFitAFloat) {
+    EXPECT_EQ(body_error(R"(<Materials><Glow keb="1e39"/></Materials>)"),
+              "t.xml:2: Glow: keb must be at most 3.40282e+38 (the largest value a float image "
+              "holds), got 1e39");
+    EXPECT_EQ(body_error(R"(<Light Px="0" Py="0" Pz="0" Radius="1e-20" Falloff="1"/>)"),
+              "t.xml:2: Light: a Falloff 1 light of radius 1e-20 is seen with radiance "
+              "I/Radius^2 past the largest value a float image holds (3.40282e+38)");
+    EXPECT_EQ(body_error(R"(<Background r="0" g="-1e39" b="0"/>)"),
+              "t.xml:2: Background: g must be at most 3.40282e+38 (the largest value a float "
+              "image holds), got -1e39");
+    // At the limit is allowed, and a point light (its light falls off) may be brighter.
+    EXPECT_NO_THROW(load(in_scene(R"(<Materials><Glow ker="3.4e38"/></Materials>
+<Light Px="0" Py="0" Pz="0" Falloff="1" Ir="1e39"/>)")));
+}
+
 TEST(SceneLoaderLightTransport, FalloffOnePointLightIsInverseSquareAndSphereLightAnEmitter) {
     const Scene scene = load(in_scene(R"(<Light Px="1" Py="2" Pz="3" Falloff="1" Ir="4"/>
 <Light Px="0" Py="0" Pz="0" Radius="2" Falloff="1" Ir="8" Ig="8" Ib="8"/>
