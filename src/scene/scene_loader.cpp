@@ -1013,7 +1013,7 @@ class SceneReader {
             read_obj_parts(e, in, obj_path, std::move(obj), transform, smooth, surface, path);
             return;
         }
-        if (!reads_uv(surface)) drop_texcoords(obj);
+        keep_texcoords_if(reads_uv(surface), obj);
         obj.triangle_materials.clear();  // one material for all: the file's make no parts
         auto mesh = build_mesh(in, std::move(obj), transform, smooth);
         if (const std::size_t n = mesh->dropped(); n > 0) {
@@ -1075,7 +1075,7 @@ class SceneReader {
                     grey_from(name.line);
                 }
             }
-            if (!reads_uv(part_surface) && !alpha) drop_texcoords(part.mesh);
+            keep_texcoords_if(reads_uv(part_surface) || alpha, part.mesh);
             auto mesh = build_mesh(in, std::move(part.mesh), transform, smooth, std::move(alpha));
             dropped += mesh->dropped();
             collapsed += mesh->collapsed();
@@ -1199,9 +1199,15 @@ class SceneReader {
 
     static bool reads_uv(const SurfaceSpec& surface) { return surface.image || surface.height; }
     // Texture coordinates no texture reads are not kept: a mesh stays as lean as without them.
-    static void drop_texcoords(ObjMesh& obj) {
-        obj.texcoords = {};
-        obj.texcoord_indices = {};
+    // Where a texture reads them, a face without `vt` is at (0, 0), in a file that has none
+    // too (a mesh without them would give each triangle its barycentrics, as a <Triangle>).
+    static void keep_texcoords_if(bool read, ObjMesh& obj) {
+        if (!read) {
+            obj.texcoords = {};
+            obj.texcoord_indices = {};
+        } else if (obj.texcoord_indices.empty()) {
+            obj.texcoord_indices.assign(obj.position_indices.size(), ObjMesh::kNoTexcoord);
+        }
     }
 
     // The images a surface names, relative to the scene file's folder, through the scene's cache.

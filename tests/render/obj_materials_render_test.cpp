@@ -151,6 +151,18 @@ TEST_F(ObjMaterialsRender, CornersWithoutVtAreAtTheOrigin) {
     }
 }
 
+// So are they in a file without any vt (the Triangle's default corners are for <Triangle>s).
+TEST_F(ObjMaterialsRender, AFileWithoutVtIsAtTheOriginToo) {
+    write_quadrants(dir_ / "q.png");
+    write("m.obj", "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n");
+    write("s.xml", uv_scene("Material=\"White\" EnableTexture=\"1\" Texture=\"image\" "
+                            "TextureFile=\"q.png\" TextureFilter=\"bilinear\""));
+    const Image image = render_file(dir_ / "s.xml");
+    for (const int x : {2, 5}) {
+        for (const int y : {2, 5}) expect_rgb(image.at(x, y), 0.5, 0.5, 0.5);
+    }
+}
+
 // A 16 x 16 mask, left half (u < ½) one value, right half another: as the alpha channel of a
 // red RGBA image, or as the grey level of an image without alpha (then its luminance counts).
 void write_half_mask(const std::filesystem::path& path, bool with_alpha) {
