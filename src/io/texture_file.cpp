@@ -145,7 +145,8 @@ Image decode_stb(const Bytes& data, const fs::path& path, Kind kind, TextureEnco
     int w = 0, h = 0, channels = 0;
     if (!stbi_info_from_memory(data.data(), size, &w, &h, &channels) || w <= 0 || h <= 0) {
         const char* reason = stbi_failure_reason();
-        fail(path, std::string("cannot decode image header: ") + (reason ? reason : "corrupt"));
+        fail(path, std::string("cannot decode image header: ") +
+                       (reason && *reason ? reason : "corrupt"));
     }
     // The size from the header alone, before stb allocates for it.
     check_size(static_cast<std::uint64_t>(w), static_cast<std::uint64_t>(h));
@@ -175,8 +176,11 @@ Image decode_stb(const Bytes& data, const fs::path& path, Kind kind, TextureEnco
         pixels.reset(stbi_load_from_callbacks(&callbacks, &reader, &w, &h, &channels, wanted));
     }
     if (!pixels) {
+        // A file cut short often leaves stb no reason to give.
+        if (reader.past_end) fail(path, "truncated image file");
         const char* reason = stbi_failure_reason();
-        fail(path, std::string("cannot decode image: ") + (reason ? reason : "unknown error"));
+        fail(path, std::string("cannot decode image: ") +
+                       (reason && *reason ? reason : "corrupt image data"));
     }
     if (reader.past_end) fail(path, "truncated image file");
     Image image(w, h);

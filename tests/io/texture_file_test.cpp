@@ -265,5 +265,20 @@ TEST(TextureFile, TruncatedFilesAreErrors) {
     }
 }
 
+// A PNG cut just before its end chunk leaves stb without a reason; the message still has one.
+TEST(TextureFile, APngWithoutItsEndChunkIsSaidToBeTruncated) {
+    const unsigned char grey[3 * 8 * 8] = {};
+    Bytes full;
+    stbi_write_png_to_func(append, &full, 8, 8, 3, grey, 3 * 8);
+    const Bytes cut(full.begin(), full.end() - 12);  // IEND: length, type and CRC
+    try {
+        decode(cut);
+        FAIL() << "no exception";
+    } catch (const ImageError& e) {
+        const std::string what = e.what();
+        EXPECT_EQ(what.substr(what.rfind(": ") + 2), "truncated image file") << what;
+    }
+}
+
 }  // namespace
 }  // namespace drt
