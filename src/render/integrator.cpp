@@ -127,80 +127,75 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
     }
     if (depth >= scene_.settings.max_depth) return result;  // deeper rays would contribute black
 
-    // The plan says whether directions are perturbed at all, the material by how much.
-    const Effects& e = plan_.effects;
     const Facing at{surface.point, geometric, shading};
+    const Scatterings rays = scatterings(ray.dir, m, at, outside);
     if (work.tree_rays >= whole_tree_rays_) {
-        return result + one_branch(ray, s, depth, work, m, at, outside, from_hit, throughput);
+        return result + one_branch(rays, m, ray.time, s, depth, work, at, from_hit, throughput);
     }
-    if (m.reflects()) {
+    if (rays.mirror) {
         const Color weight = m.reflective * m.ks;
-        const Scatter reflection{reflect_above(ray.dir, shading, geometric),
-                                 e.glossy_reflection ? m.sigma() : 0.0, +1, dim::kGlossReflect,
-                                 false};
-        result += weight * scattered(at, from_hit, reflection, throughput * max_component(weight),
+        result += weight * scattered(at, from_hit, *rays.mirror, throughput * max_component(weight),
                                      ray.time, s, depth, work);
     }
     if (m.transmits()) {
-        const double sigma = m.sigma();
-        // The medium outside every object is air (index 1), as in the thesis.
-        const double eta = outside ? 1.0 / m.index : m.index;
-        const double cos_i = std::max(0.0, -dot(ray.dir, shading));
-        const double fresnel = fresnel_dielectric(cos_i, eta);
+        const double fresnel = rays.fresnel;
         const double weight = throughput * max_component(m.transmit * m.kt);
         Color glass;
-        if (fresnel > 0) {
-            const Scatter reflection{reflect_above(ray.dir, shading, geometric),
-                                     e.glossy_reflection ? sigma : 0.0, +1, dim::kGlassReflect,
-                                     false};
-            glass += fresnel * scattered(at, from_hit, reflection, weight * fresnel, ray.time, s,
-                                         depth, work);
+        if (rays.glass_reflection) {
+            glass += fresnel * scattered(at, from_hit, *rays.glass_reflection, weight * fresnel,
+                                         ray.time, s, depth, work);
         }
-        if (fresnel < 1) {
-            if (const auto through = refract_below(ray.dir, shading, geometric, eta)) {
-                const Scatter refraction{*through, e.glossy_refraction ? sigma : 0.0, -1,
-                                         dim::kGlossRefract, true};
-                glass +=
-                    (1.0 - fresnel) * scattered(at, from_hit, refraction, weight * (1.0 - fresnel),
-                                                ray.time, s, depth, work);
-            }
+        if (rays.refraction) {
+            glass +=
+                (1.0 - fresnel) * scattered(at, from_hit, *rays.refraction,
+                                            weight * (1.0 - fresnel), ray.time, s, depth, work);
         }
         result += m.transmit * m.kt * glass;
     }
     return result;
 }
 
-Color Integrator::one_branch(const Ray& ray, const PixelSample& s, int depth, PixelWork& work,
-                             const Material& m, const Facing& at, bool outside, Leaving leaving,
-                             double throughput) const {
-    const Vec3& geometric = at.geometric;
-    const Vec3& shading = at.shading;
+Integrator::Scatterings Integrator::scatterings(const Vec3& dir, const Material& m,
+                                                const Facing& at, bool outside) const {
+    // The plan says whether directions are perturbed at all, the material by how much.
     const Effects& e = plan_.effects;
     const double sigma = m.sigma();
-    // The rays the whole tree would trace here, as radiance() does, each with its weight.
-    std::array<std::pair<Color, Scatter>, 3> branches;
-    int count = 0;
+    Scatterings rays;
     if (m.reflects()) {
-        branches[count++] = {m.reflective * m.ks,
-                             {reflect_above(ray.dir, shading, geometric),
-                              e.glossy_reflection ? sigma : 0.0, +1, dim::kGlossReflect, false}};
+        rays.mirror = {reflect_above(dir, at.shading, at.geometric),
+                       e.glossy_reflection ? sigma : 0.0, +1, dim::kGlossReflect, false};
     }
     if (m.transmits()) {
+        // The medium outside every object is air (index 1), as in the thesis.
         const double eta = outside ? 1.0 / m.index : m.index;
-        const double fresnel = fresnel_dielectric(std::max(0.0, -dot(ray.dir, shading)), eta);
-        const Color glass = m.transmit * m.kt;
-        if (fresnel > 0) {
-            branches[count++] = {
-                glass * fresnel,
-                {reflect_above(ray.dir, shading, geometric), e.glossy_reflection ? sigma : 0.0, +1,
-                 dim::kGlassReflect, false}};
+        rays.fresnel = fresnel_dielectric(std::max(0.0, -dot(dir, at.shading)), eta);
+        if (rays.fresnel > 0) {
+            rays.glass_reflection = {reflect_above(dir, at.shading, at.geometric),
+                                     e.glossy_reflection ? sigma : 0.0, +1, dim::kGlassReflect,
+                                     false};
         }
-        if (const auto through = refract_below(ray.dir, shading, geometric, eta);
-            fresnel < 1 && through) {
-            branches[count++] = {
-                glass * (1.0 - fresnel),
-                {*through, e.glossy_refraction ? sigma : 0.0, -1, dim::kGlossRefract, true}};
+        if (rays.fresnel < 1) {
+            if (const auto through = refract_below(dir, at.shading, at.geometric, eta)) {
+                rays.refraction = {*through, e.glossy_refraction ? sigma : 0.0, -1,
+                                   dim::kGlossRefract, true};
+            }
         }
+    }
+    return rays;
+}
+
+Color Integrator::one_branch(const Scatterings& rays, const Material& m, double time,
+                             const PixelSample& s, int depth, PixelWork& work, const Facing& at,
+                             Leaving leaving, double throughput) const {
+    // The rays the whole tree would trace here, each with its weight.
+    std::array<std::pair<Color, Scatter>, 3> branches;
+    int count = 0;
+    if (rays.mirror) branches[count++] = {m.reflective * m.ks, *rays.mirror};
+    if (rays.glass_reflection) {
+        branches[count++] = {m.transmit * m.kt * rays.fresnel, *rays.glass_reflection};
+    }
+    if (rays.refraction) {
+        branches[count++] = {m.transmit * m.kt * (1.0 - rays.fresnel), *rays.refraction};
     }
     double total = 0;
     for (int i = 0; i < count; ++i) total += max_component(branches[i].first);
@@ -215,8 +210,7 @@ Color Integrator::one_branch(const Ray& ray, const PixelSample& s, int depth, Pi
     }
     const auto& [weight, how] = branches[pick];
     const double odds = max_component(weight) / total;
-    return weight / odds *
-           scattered(at, leaving, how, throughput * total, ray.time, s, depth, work);
+    return weight / odds * scattered(at, leaving, how, throughput * total, time, s, depth, work);
 }
 
 Color Integrator::scattered(const Facing& at, Leaving leaving, const Scatter& how,

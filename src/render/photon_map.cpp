@@ -58,8 +58,15 @@ double photon_radius2_factor(std::uint32_t pass) {
 }
 
 double default_photon_radius(const Scene& scene) {
+    // The box where caustics form: the objects that bend light and catch it. An emitter (a
+    // Falloff-1 sphere light, an emitting mesh) lights the scene from wherever it is, often far
+    // off, and would make the radius too wide to show any caustic; it counts only when the scene
+    // has nothing else.
+    const bool lit_objects = std::ranges::any_of(
+        scene.objects, [](const auto& object) { return !object->material().emits(); });
     Bounds bounds;
     for (const auto& object : scene.objects) {
+        if (lit_objects && object->material().emits()) continue;
         const Shapes shapes = object->shapes();
         for (const SphereShape& s : shapes.spheres) {
             const Vec3 c = s.path->at(0);

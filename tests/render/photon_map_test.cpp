@@ -155,6 +155,28 @@ TEST(PhotonMap, RadiusShrinksByTheProbabilisticRule) {
     EXPECT_DOUBLE_EQ(m.maps.pass(0, 7)->radius(), 0.2 * std::sqrt(photon_radius2_factor(7)));
 }
 
+// Without a Radius the first gather radius is 1/100 of the box around the objects that make and
+// catch caustics: a far Falloff-1 sphere light or emitting sphere does not widen it (it made the
+// radius 10 here, and the caustic a blur). With nothing but emitters, their box it is.
+TEST(PhotonMap, TheDefaultRadiusLeavesFarEmittersOut) {
+    const std::string ball = R"(<Scene><Materials><Glass transmitt="1" index="1.5"/>
+      <Lamp ker="1e5" keg="1e5" keb="1e5"/></Materials>
+      <Sphere Px="0" Py="0" Pz="0" Radius="1" Material="Glass"/>)";
+    const double ball_box = std::sqrt(12.0) / 100;  // the diagonal of a 2 x 2 x 2 box
+    EXPECT_DOUBLE_EQ(
+        default_photon_radius(
+            from_xml(ball + R"(<Light Px="0" Py="1000" Pz="0" Radius="10" Falloff="1"/></Scene>)")),
+        ball_box);
+    EXPECT_DOUBLE_EQ(
+        default_photon_radius(from_xml(
+            ball + R"(<Sphere Px="0" Py="900" Pz="0" Radius="0.1" Material="Lamp"/></Scene>)")),
+        ball_box);
+    EXPECT_DOUBLE_EQ(default_photon_radius(from_xml(
+                         R"(<Scene><Materials><Lamp ker="1"/></Materials>
+      <Sphere Px="0" Py="0" Pz="0" Radius="50" Material="Lamp"/></Scene>)")),
+                     std::sqrt(3.0) * 100 / 100);
+}
+
 // Transmission through the ball: the photons' power on the floor is the light the ball
 // intercepts times the model's transmission, to 1 % (the noise is 0.1 %).
 TEST(PhotonMap, BallPassesTheInterceptedLightTimesItsTransmission) {

@@ -139,11 +139,19 @@ class Integrator final : public PixelIntegrator {
         std::uint32_t kind;
         bool refraction;
     };
-    // The reflected and refracted light of material m at a hit along one of the rays the whole
-    // tree would trace there, picked in proportion to its weight (past kWholeTreeRays);
-    // `outside`: the ray arrived from outside the surface; `leaving`: the hit's triangle.
-    Color one_branch(const Ray& ray, const PixelSample& s, int depth, PixelWork& work,
-                     const Material& m, const Facing& at, bool outside, Leaving leaving,
+    // The reflected and refracted rays material m calls for at a hit that `dir` arrived at
+    // (from outside the surface or not), as the whole tree traces them, and the Fresnel factor
+    // that weighs the glass's two.
+    struct Scatterings {
+        std::optional<Scatter> mirror, glass_reflection, refraction;
+        double fresnel = 0;
+    };
+    Scatterings scatterings(const Vec3& dir, const Material& m, const Facing& at,
+                            bool outside) const;
+    // The reflected and refracted light of material m at a hit along one of `rays`, picked in
+    // proportion to its weight (past kWholeTreeRays); `leaving`: the hit's triangle.
+    Color one_branch(const Scatterings& rays, const Material& m, double time, const PixelSample& s,
+                     int depth, PixelWork& work, const Facing& at, Leaving leaving,
                      double throughput) const;
     // Average radiance along the scattered rays of `how` (GlossyRays of them for a perturbed
     // direction at the first hit, else one), skipping the triangle `leaving`.
