@@ -74,6 +74,11 @@ Integrator::Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bv
         any_visible_light_ = any_visible_light_ || light->visible();
         if (!light->is_point()) area_lights_.push_back(light.get());
     }
+    for (const auto& object : scene.objects) {
+        if (object->material().emits() && !object->shapes().planes.empty()) {
+            emitting_planes_.push_back(object.get());
+        }
+    }
 }
 
 void Integrator::sample_pixel(int x, int y, const PixelSample& s, std::span<Color> out,
@@ -391,7 +396,34 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
                    (p * rays);
         }
     }
+    if (!emitting_planes_.empty()) {
+        sum += plane_light(origin, leaving, geometric, shading, time, s, depth, counts);
+    }
     return sum;
+}
+
+Color Integrator::plane_light(const Vec3& origin, Leaving leaving, const Vec3& geometric,
+                              const Vec3& shading, double time, const PixelSample& s, int depth,
+                              RayCounts& counts) const {
+    // Rays in cosine-weighted directions (density cos θ / π), each bringing what an emitting
+    // plane it meets first emits: in direct_light's units (I · cos for a thesis light), a
+    // direction of radiance L counts L · cos / (π · density) = L. Only planes count: every other
+    // emitter is sampled above, so a ray that meets one adds nothing.
+    const int rays = scene_.settings.shadow_rays;
+    const std::uint32_t dimension = dim::light(depth, scene_.lights.size() + plan_.emitters.size());
+    Color sum;
+    for (int j = 0; j < rays; ++j) {
+        const Vec2 u = rays == 1 ? sampler_.get_2d(s, dimension)
+                                 : sampler_.get_2d_in_set(s, dimension, j, rays);
+        const Vec3 dir = cosine_direction(shading, u);
+        if (lit_cosine(dir, shading, geometric) == 0) continue;
+        ++counts.shadow;
+        const auto hit = bvh_.intersect({origin, dir, time}, {0, kInfinity}, leaving);
+        if (hit && std::ranges::find(emitting_planes_, hit->object) != emitting_planes_.end()) {
+            sum += hit->object->material().emission;
+        }
+    }
+    return rays == 1 ? sum : sum / rays;
 }
 
 }  // namespace drt

@@ -41,14 +41,6 @@ double power_heuristic(double own, double other) {
     return 1 / (1 + r * r);
 }
 
-// A direction about unit `n` with density cos θ / π.
-Vec3 cosine_direction(const Vec3& n, Vec2 u) {
-    const double r = std::sqrt(u.x);
-    const SinCos phi = sincos_turns(u.y);
-    const Vec3 local{r * phi.cos, r * phi.sin, std::sqrt(std::max(0.0, 1 - u.x))};
-    return normalize(Frame::around(n).to_world(local));
-}
-
 }  // namespace
 
 PathIntegrator::PathIntegrator(const Scene& scene, const RenderPlan& plan, const Bvh& bvh,

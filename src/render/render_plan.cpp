@@ -158,7 +158,7 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
     }
     if (emitting_planes > 0) {
         out << "  emitting planes: " << emitting_planes
-            << " (seen by rays; light found by scattered rays only)\n";
+            << " (seen by rays; their light found by rays in cosine-weighted directions)\n";
     }
     if (plan.shared_rays > 0) {
         out << "  fewer shadow rays than area lights: each of " << plan.shared_rays

@@ -1013,9 +1013,10 @@ TEST_F(CliTest, NonFinitePixelsAreCountedAndFailTheRun) {
     write_bytes(file("sky.xml"), scene_with("<Background r=\"0.1\"", "<Background r=\"1.7e308\""));
     const Outcome sky = run({"sky.xml", "-o", "sky.pfm", "-q"});
     EXPECT_EQ(sky.status, 2);
-    EXPECT_TRUE(regex_search(sky.err, "^sky\\.xml:[0-9]+: Background: r must be at most "
-                                      "3\\.40282e\\+38 \\(the largest value a float image "
-                                      "holds\\), got 1\\.7e308\n$"))
+    EXPECT_TRUE(regex_search(sky.err,
+                             "^sky\\.xml:[0-9]+: Background: r must be at most "
+                             "3\\.40282e\\+38 \\(the largest value a float image "
+                             "holds\\), got 1\\.7e308\n$"))
         << sky.err;
     EXPECT_FALSE(fs::exists(file("sky.pfm")));
     EXPECT_EQ(run({"scene.xml", "-o", "ok.pfm", "-q"}).status, 0);

@@ -116,6 +116,12 @@ class Integrator final : public PixelIntegrator {
     Color direct_light(const Vec3& point, const Vec3& geometric, const Vec3& shading,
                        Leaving leaving, double time, const PixelSample& s, int depth,
                        RayCounts& counts) const;
+    // The light of the emitting planes at a point, from ShadowRays rays leaving `origin` in
+    // cosine-weighted directions (an infinite plane has no area to sample), in the units of
+    // direct_light.
+    Color plane_light(const Vec3& origin, Leaving leaving, const Vec3& geometric,
+                      const Vec3& shading, double time, const PixelSample& s, int depth,
+                      RayCounts& counts) const;
     // One shadow ray from `origin` (spawned off the shading point) along a light sample.
     Color light_ray(const Light& light, const LightSample& ls, const Vec3& origin, Leaving leaving,
                     const Vec3& geometric, const Vec3& shading, double time,
@@ -166,6 +172,7 @@ class Integrator final : public PixelIntegrator {
     Camera camera_;
     std::vector<const Light*> area_lights_;  // in scene order, as plan_.light_pick_cdf
     bool any_visible_light_ = false;
+    std::vector<const Object*> emitting_planes_;  // objects with an emitting plane
     std::uint64_t whole_tree_rays_;
 };
 

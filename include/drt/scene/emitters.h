@@ -5,7 +5,8 @@
 // subtends (sampling/spherical_triangle.h) from points near it, by area from farther off or
 // where that angle is too small or too close to a hemisphere to be sampled soundly (the rule is
 // in emitters.cpp); a Falloff-1 point light is a point.
-// Emitting planes are infinite: they are seen by rays and found by scattered rays only. The
+// Emitting planes are infinite: they are seen by rays and found by rays in cosine-weighted
+// directions (scattered ones, or the distributed integrator's plane_light), not here. The
 // scene's environment, if any, is the last emitter, sampled by its own distribution
 // (environment.h) at an infinite distance.
 #pragma once

@@ -160,6 +160,14 @@ struct Frame {
     constexpr Vec3 to_world(const Vec3& v) const { return t * v.x + b * v.y + n * v.z; }
 };
 
+// A direction about unit `n` with density cos θ / π, from a uniform point u of the unit square.
+inline Vec3 cosine_direction(const Vec3& n, Vec2 u) {
+    const double r = std::sqrt(u.x);
+    const SinCos phi = sincos_turns(u.y);
+    const Vec3 local{r * phi.cos, r * phi.sin, std::sqrt(std::max(0.0, 1 - u.x))};
+    return normalize(Frame::around(n).to_world(local));
+}
+
 struct Interval {
     double min = 0, max = kInfinity;
     constexpr bool contains(double v) const { return min <= v && v <= max; }
