@@ -19,6 +19,14 @@ void add_sphere_light(Scene& scene, Vec3 centre, double radius, Color intensity 
     scene.lights.push_back(std::make_unique<SphereLight>(centre, radius, intensity, false));
 }
 
+// An 8 x 8 floor scene with a sphere of radius 1 along `path` (one point: a still sphere).
+Scene floor_with_sphere(std::vector<Vec3> path) {
+    Scene scene = floor_scene(8, 8);
+    scene.objects.push_back(
+        std::make_unique<Sphere>(std::move(path), 1.0, *scene.materials.front()));
+    return scene;
+}
+
 TEST(RenderPlan, PointLightGetsExactlyOneShadowRay) {
     Scene scene = floor_scene(8, 8);
     scene.settings.shadow_rays = 10;
@@ -110,10 +118,7 @@ TEST(RenderPlan, EffectsFollowTheScene) {
     Scene blurry_glass = lone_sphere_scene(testing::glass(1.5, 50.0), {1, 1, 1});
     EXPECT_TRUE(plan_render(blurry_glass).effects.glossy_refraction);
 
-    Scene moving = floor_scene(4, 4);
-    const Material& m = *moving.materials.front();
-    moving.objects.push_back(
-        std::make_unique<Sphere>(std::vector<Vec3>{{0, 5, 0}, {1, 5, 0}, {2, 5, 0}}, 1.0, m));
+    const Scene moving = floor_with_sphere({{0, 5, 0}, {1, 5, 0}, {2, 5, 0}});
     const RenderPlan plan = plan_render(moving);
     EXPECT_TRUE(plan.effects.motion_blur);
     EXPECT_EQ(plan.shutter_end, 2.0);
@@ -123,21 +128,15 @@ TEST(RenderPlan, EffectsFollowTheScene) {
 // the same image as without them. Beside a moving object, the still path's length still sets
 // the shutter, as it always has.
 TEST(RenderPlan, APathThatStaysInOnePlaceBlursNothing) {
-    Scene still = floor_scene(8, 8);
-    const Material& m = *still.materials.front();
-    still.objects.push_back(
-        std::make_unique<Sphere>(std::vector<Vec3>{{0, 5, 0}, {0, 5, 0}, {0, 5, 0}}, 1.0, m));
+    Scene still = floor_with_sphere({{0, 5, 0}, {0, 5, 0}, {0, 5, 0}});
     const RenderPlan plan = plan_render(still);
     EXPECT_FALSE(plan.effects.motion_blur);
     EXPECT_EQ(plan.shutter_end, 0.0);
     EXPECT_NE(describe(still, plan).find("(0 moving)"), std::string::npos);
+    EXPECT_EQ(render_with(still).image.rgb, render_with(floor_with_sphere({{0, 5, 0}})).image.rgb);
 
-    Scene plain = floor_scene(8, 8);
-    plain.objects.push_back(std::make_unique<Sphere>(std::vector<Vec3>{{0, 5, 0}}, 1.0, m));
-    EXPECT_EQ(render_with(still).image.rgb, render_with(plain).image.rgb);
-
-    still.objects.push_back(
-        std::make_unique<Sphere>(std::vector<Vec3>{{3, 5, 0}, {4, 5, 0}}, 1.0, m));
+    still.objects.push_back(std::make_unique<Sphere>(std::vector<Vec3>{{3, 5, 0}, {4, 5, 0}}, 1.0,
+                                                     *still.materials.front()));
     const RenderPlan mixed = plan_render(still);
     EXPECT_TRUE(mixed.effects.motion_blur);
     EXPECT_EQ(mixed.shutter_end, 2.0);
