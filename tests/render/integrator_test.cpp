@@ -17,6 +17,7 @@
 #include "drt/render/render_plan.h"
 #include "drt/render/renderer.h"
 #include "drt/sampling/sampler.h"
+#include "sanitizers.h"
 #include "test_render.h"
 #include "test_scenes.h"
 
@@ -500,11 +501,19 @@ std::pair<Color, std::uint64_t> tree_render(const Scene& scene, std::uint64_t wh
 // Past the bound a hit follows one ray, picked by weight, and rays survive Russian roulette by
 // their throughput, each divided by its odds: the mean of many camera samples is the whole
 // tree's, for a quarter of the rays. (Each seed's mean scatters by about 3 % about the whole
-// tree's; the sixteen seeds' by about 0.4 %.)
+// tree's; sixteen seeds' by about 0.4 %, four seeds' by 0.8 %: the sanitizer build, 30 times
+// slower, takes four and a wider bound.)
 TEST(Integrator, ATreePastItsBoundFollowsOneRayWithoutBias) {
+#if defined(DRT_TEST_ASAN)
+    constexpr std::uint64_t kSeeds = 4;
+    constexpr double kTolerance = 0.03;
+#else
+    constexpr std::uint64_t kSeeds = 16;
+    constexpr double kTolerance = 0.015;
+#endif
     Color whole, bounded;
     std::uint64_t whole_rays = 0, bounded_rays = 0;
-    for (std::uint64_t seed = 0; seed < 16; ++seed) {
+    for (std::uint64_t seed = 0; seed < kSeeds; ++seed) {
         Scene scene = testing::from_xml(glass_among_mirrors(6, 32, 16));
         scene.settings.seed = seed;
         const auto [w, w_rays] = tree_render(scene, ~std::uint64_t{0});
@@ -513,7 +522,7 @@ TEST(Integrator, ATreePastItsBoundFollowsOneRayWithoutBias) {
         whole_rays += w_rays, bounded_rays += b_rays;
     }
     EXPECT_GT(whole_rays, 3 * bounded_rays);
-    testing::expect_relative(bounded, whole, 0.015, "bounded tree against the whole tree");
+    testing::expect_relative(bounded, whole, kTolerance, "bounded tree against the whole tree");
 }
 
 // Glass between two glossy mirrors, which send back both rays of every split: the whole tree
