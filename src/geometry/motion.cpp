@@ -13,9 +13,7 @@ Vec3 MotionPath::moving_at(double time) const {
 }
 
 bool MotionPath::travels() const {
-    return std::ranges::any_of(points_, [&](const Vec3& p) {
-        return p.x != points_[0].x || p.y != points_[0].y || p.z != points_[0].z;
-    });
+    return std::ranges::any_of(points_, [&](const Vec3& p) { return p != points_[0]; });
 }
 
 Interval MotionPath::segment_time(std::size_t k) const {

@@ -1,5 +1,6 @@
 #include "drt/geometry/object.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace drt {
@@ -43,6 +44,12 @@ SurfaceUv through_corners(const SurfaceUv& at, const std::array<Vec2, 3>& corner
 }
 
 }  // namespace
+
+bool Object::travels() const {
+    const Shapes all = shapes();
+    return std::ranges::any_of(all.spheres, [](const auto& s) { return s.path->travels(); }) ||
+           std::ranges::any_of(all.meshes, [](const auto& m) { return m.path->travels(); });
+}
 
 SurfaceUv Object::surface_uv(const Ray&, const Hit&, const SurfaceHit&) const {
     return {};

@@ -107,7 +107,7 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
     const RenderSettings& s = scene.settings;
     std::ostringstream out;
     std::size_t moving = 0;
-    for (const auto& object : scene.objects) moving += travels(*object) ? 1 : 0;
+    for (const auto& object : scene.objects) moving += object->travels() ? 1 : 0;
     out << "scene: " << scene.path << "\n"
         << "image: " << s.width << "x" << s.height << "\n"
         << "samples per pixel: " << s.samples << "\n"

@@ -9,18 +9,12 @@ Camera Scene::camera() const {
     return Camera::thesis_default(settings.width, settings.height, lens, settings.pixel_plane_unit);
 }
 
-bool travels(const Object& object) {
-    const Shapes shapes = object.shapes();
-    return std::ranges::any_of(shapes.spheres, [](const auto& s) { return s.path->travels(); }) ||
-           std::ranges::any_of(shapes.meshes, [](const auto& m) { return m.path->travels(); });
-}
-
 double Scene::shutter_end() const {
     double end = 0;
     bool any_travels = false;
     for (const auto& object : objects) {
         end = std::max(end, object->motion_end());
-        any_travels = any_travels || travels(*object);
+        any_travels = any_travels || object->travels();
     }
     // Paths that all stay in one place blur nothing, so no shutter time is drawn; where anything
     // moves, the longest path sets the shutter, a still one included.

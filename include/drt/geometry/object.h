@@ -141,6 +141,8 @@ class Object {
     // Shutter time at which the object's motion path ends; 0 for an object that stays put.
     virtual double motion_end() const { return 0; }
     bool moves() const { return motion_end() > 0; }
+    // Whether it goes anywhere: a motion path whose points are not all one place.
+    bool travels() const;
 
     // Surface information at a hit on this object by `ray`. An image texture is filtered over
     // the footprint of `differential` where given (camera rays), else read at its finest level.

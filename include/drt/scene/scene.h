@@ -80,7 +80,4 @@ struct Scene {
     const Material* find_material(const std::string& name) const;
 };
 
-// Whether the object goes anywhere: a motion path whose points are not all one place.
-bool travels(const Object& object);
-
 }  // namespace drt
