@@ -83,7 +83,7 @@ Integrator::Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bv
 
 void Integrator::sample_pixel(int x, int y, const PixelSample& s, std::span<Color> out,
                               RayCounts& counts) const {
-    PixelWork work{counts, RunPoints(sampler_, s, static_cast<std::uint32_t>(out.size())), 0};
+    PixelWork work{counts, RunPoints(sampler_, s, static_cast<std::uint32_t>(out.size()))};
     const CameraRays rays(camera_, sampler_, plan_, x, y, s, out.size());
     PixelSample sample = s;
     for (std::size_t i = 0; i < out.size(); ++i, ++sample.index) {
@@ -95,7 +95,7 @@ void Integrator::sample_pixel(int x, int y, const PixelSample& s, std::span<Colo
 
 Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth,
                            RayCounts& counts) const {
-    PixelWork work{counts, RunPoints(sampler_, s, 0), 0};
+    PixelWork work{counts, RunPoints(sampler_, s, 0)};
     return radiance(ray, s, depth, work);
 }
 
@@ -360,8 +360,7 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
         const std::uint32_t dimension = dim::light(depth, scene_.lights.size() + i);
         Color emitter_sum;
         for (int j = 0; j < rays; ++j) {
-            const Vec2 u = rays == 1 ? sampler_.get_2d(s, dimension)
-                                     : sampler_.get_2d_in_set(s, dimension, j, rays);
+            const Vec2 u = sampler_.get_2d_for_ray(s, dimension, j, rays);
             emitter_sum +=
                 emitter_ray(i, u, point, origin, leaving, geometric, shading, time, counts);
         }
@@ -373,8 +372,7 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
         const int rays = plan_.shared_rays;
         const std::uint32_t dimension = dim::bounce(depth, dim::kLightPick);
         for (int j = 0; j < rays; ++j) {
-            Vec2 u = rays == 1 ? sampler_.get_2d(s, dimension)
-                               : sampler_.get_2d_in_set(s, dimension, j, rays);
+            Vec2 u = sampler_.get_2d_for_ray(s, dimension, j, rays);
             const auto& cdf = plan_.light_pick_cdf;
             const std::size_t k = std::min<std::size_t>(
                 std::upper_bound(cdf.begin(), cdf.end(), u.x) - cdf.begin(), cdf.size() - 1);
@@ -413,8 +411,7 @@ Color Integrator::plane_light(const Vec3& origin, Leaving leaving, const Vec3& g
     const std::uint32_t dimension = dim::light(depth, scene_.lights.size() + plan_.emitters.size());
     Color sum;
     for (int j = 0; j < rays; ++j) {
-        const Vec2 u = rays == 1 ? sampler_.get_2d(s, dimension)
-                                 : sampler_.get_2d_in_set(s, dimension, j, rays);
+        const Vec2 u = sampler_.get_2d_for_ray(s, dimension, j, rays);
         const Vec3 dir = cosine_direction(shading, u);
         if (lit_cosine(dir, shading, geometric) == 0) continue;
         ++counts.shadow;

@@ -275,17 +275,13 @@ Color PathIntegrator::next_event(const Vec3& point, const Vec3& geometric, const
                                  double diffuse_pick, RayCounts& counts) const {
     const Vec3 origin = spawn_ray(point, geometric, geometric, time).origin;
     const bool emitters = strategy_ != Strategy::kScatterOnly;
-    const auto point_of = [&](std::uint32_t dimension, int j, int rays) {
-        return rays == 1 ? sampler_.get_2d(s, dimension)
-                         : sampler_.get_2d_in_set(s, dimension, static_cast<std::uint32_t>(j),
-                                                  static_cast<std::uint32_t>(rays));
-    };
     Color sum;
     for (std::size_t i = 0; i < scene_.lights.size(); ++i) {
         const int rays = plan_.shadow_rays[i];
         Color light_sum;
         for (int j = 0; j < rays; ++j) {
-            light_sum += light_ray(*scene_.lights[i], point_of(path_dim::light(depth, i), j, rays),
+            light_sum += light_ray(*scene_.lights[i],
+                                   sampler_.get_2d_for_ray(s, path_dim::light(depth, i), j, rays),
                                    point, origin, leaving, geometric, shading, time, counts);
         }
         if (rays > 0) sum += light_sum / rays;
@@ -295,8 +291,9 @@ Color PathIntegrator::next_event(const Vec3& point, const Vec3& geometric, const
         const std::uint32_t dimension = path_dim::light(depth, scene_.lights.size() + i);
         Color emitter_sum;
         for (int j = 0; j < rays; ++j) {
-            emitter_sum += emitter_ray(i, point_of(dimension, j, rays), point, origin, leaving,
-                                       geometric, shading, time, diffuse_pick, counts);
+            emitter_sum +=
+                emitter_ray(i, sampler_.get_2d_for_ray(s, dimension, j, rays), point, origin,
+                            leaving, geometric, shading, time, diffuse_pick, counts);
         }
         if (rays > 0) sum += emitter_sum / rays;
     }
@@ -306,7 +303,7 @@ Color PathIntegrator::next_event(const Vec3& point, const Vec3& geometric, const
         const int rays = plan_.shared_rays;
         const auto& cdf = plan_.light_pick_cdf;
         for (int j = 0; j < rays; ++j) {
-            Vec2 u = point_of(path_dim::at(depth, path_dim::kLightPick), j, rays);
+            Vec2 u = sampler_.get_2d_for_ray(s, path_dim::at(depth, path_dim::kLightPick), j, rays);
             const std::size_t k = std::min<std::size_t>(
                 std::upper_bound(cdf.begin(), cdf.end(), u.x) - cdf.begin(), cdf.size() - 1);
             const double lo = k == 0 ? 0.0 : cdf[k - 1];

@@ -102,8 +102,8 @@ class Integrator final : public PixelIntegrator {
     // What the paths of one run of a pixel's samples share.
     struct PixelWork {
         RayCounts& counts;
-        RunPoints points;         // of the glossy dimensions
-        std::uint64_t tree_rays;  // reflected and refracted rays of the current camera sample
+        RunPoints points;             // of the glossy dimensions
+        std::uint64_t tree_rays = 0;  // reflected and refracted rays of the current camera sample
     };
 
     // `leaving`: the triangle the ray leaves from, which it skips (bvh.h); `throughput`: the

@@ -73,6 +73,13 @@ class Sampler {
     // the glossy rays of one hit): the k points are distributed well together.
     virtual Vec2 get_2d_in_set(const PixelSample& s, std::uint32_t dim, std::uint32_t j,
                                std::uint32_t k) const = 0;
+    // Ray j of `rays` taken at one shading point: the camera sample's own point of `dim` for a
+    // lone ray (stratified across the pixel's samples), point j of the set for several.
+    Vec2 get_2d_for_ray(const PixelSample& s, std::uint32_t dim, int j, int rays) const {
+        return rays == 1 ? get_2d(s, dim)
+                         : get_2d_in_set(s, dim, static_cast<std::uint32_t>(j),
+                                         static_cast<std::uint32_t>(rays));
+    }
     // Points first .. first + out.size() - 1 of that set of k, exactly as get_2d_in_set gives
     // them, at once: a sampler can work out what the points share (the set's key) only once.
     virtual void get_2d_set(const PixelSample& s, std::uint32_t dim, std::uint32_t k,
