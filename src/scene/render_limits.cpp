@@ -12,6 +12,16 @@ std::uint64_t photon_bytes(const RenderSettings& settings) {
            std::uint64_t(std::max(settings.photons->count, 0)) * kBytesPerPhoton;
 }
 
+std::optional<std::string> photon_budget_problem(const RenderSettings& s) {
+    const std::uint64_t bytes = photon_bytes(s);
+    if (bytes <= kMaxPhotonBytes) return std::nullopt;
+    return "the photon maps need an estimated " + std::to_string(bytes >> 20) + " MiB (" +
+           std::to_string(s.samples) + " passes x " + std::to_string(s.photons->count) +
+           " photons x " + std::to_string(kBytesPerPhoton) + " B), more than their " +
+           std::to_string(kMaxPhotonBytes >> 20) +
+           " MiB share of the budget: lower Samples or the Photons Count";
+}
+
 std::uint64_t estimated_render_bytes(const RenderSettings& settings, int threads) {
     const std::uint64_t pixels =
         std::uint64_t(std::max(settings.width, 0)) * std::uint64_t(std::max(settings.height, 0));
@@ -41,13 +51,7 @@ std::optional<std::string> render_limit_problem(const RenderSettings& s, int thr
     if (s.glossy_rays > kMaxRaysPerPoint)
         return over("glossy rays", s.glossy_rays, kMaxRaysPerPoint);
     if (s.max_depth > kMaxDepthLimit) return over("max depth", s.max_depth, kMaxDepthLimit);
-    if (const std::uint64_t photons = photon_bytes(s); photons > kMaxPhotonBytes) {
-        return "the photon maps need an estimated " + std::to_string(photons >> 20) + " MiB (" +
-               std::to_string(s.samples) + " passes x " + std::to_string(s.photons->count) +
-               " photons x " + std::to_string(kBytesPerPhoton) + " B), more than their " +
-               std::to_string(kMaxPhotonBytes >> 20) +
-               " MiB share of the budget: lower Samples or the Photons Count";
-    }
+    if (auto photons = photon_budget_problem(s)) return photons;
     const int workers = worker_threads(threads);
     const std::uint64_t bytes = estimated_render_bytes(s, workers);
     if (bytes > kMemoryBudget) {

@@ -32,6 +32,7 @@
 #include "drt/io/obj_reader.h"
 #include "drt/sampling/sampler.h"
 #include "drt/scene/obj_materials.h"
+#include "drt/scene/render_limits.h"
 #include "drt/scene/texture_cache.h"
 #include "drt/shading/image_texture.h"
 #include "drt/shading/texture.h"
@@ -422,6 +423,7 @@ class SceneReader {
         const XMLElement& root = root_element(doc);
         scene_.path = context_.file();
         read_scene(root);
+        check_photon_budget();
         build_triangle_groups();
         resolve_objects();
         add_emitting_lights();
@@ -654,6 +656,13 @@ class SceneReader {
         scene_.settings.photons = p;
         in.warn_unknown();
         warn_children(e);
+    }
+
+    // Samples and Count may stand in either order, so their product is checked once both are read.
+    void check_photon_budget() const {
+        if (const auto problem = photon_budget_problem(scene_.settings)) {
+            context_.fail_at(setting_lines_.at("Photons"), "Photons", *problem);
+        }
     }
 
     static std::string sampler_list() {

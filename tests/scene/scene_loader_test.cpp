@@ -872,6 +872,19 @@ TEST(SceneLoaderLimits, PixelCountAtAndPastTheLimit) {
               "(docs/scene-format.md#limits)");
 }
 
+// Every pass's photon map is kept: Samples x Count x 48 B must fit 1024 MiB, whichever of the
+// two elements comes first; the message names <Photons>.
+TEST(SceneLoaderLimits, PhotonMapsAtAndPastTheirShareOfTheBudget) {
+    EXPECT_EQ(body_error("<Render Samples=\"65536\"/>\n<Photons Count=\"341\"/>"), "loaded");
+    const std::string past =
+        ": Photons: the photon maps need an estimated 1026 MiB (65536 passes x 342 photons x "
+        "48 B), more than their 1024 MiB share of the budget: lower Samples or the Photons Count";
+    EXPECT_EQ(body_error("<Render Samples=\"65536\"/>\n<Photons Count=\"342\"/>"),
+              "t.xml:3" + past);
+    EXPECT_EQ(body_error("<Photons Count=\"342\"/>\n<Render Samples=\"65536\"/>"),
+              "t.xml:2" + past);
+}
+
 TEST(SceneLoaderLimits, CountsAtAndPastTheirLimits) {
     EXPECT_EQ(body_error(R"(<Render Samples="65536" ShadowRays="65536" GlossyRays="65536"
                                  MaxDepth="512"/>)"),

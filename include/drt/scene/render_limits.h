@@ -14,6 +14,11 @@ namespace drt {
 // <Photons>): every pass's map, each photon stored at most once.
 std::uint64_t photon_bytes(const RenderSettings& settings);
 
+// Why the photon maps of these settings would not fit their share of the budget, or nothing.
+// The loader asks it of the scene's own settings (to name the <Photons> line), a render of the
+// settings the command line leaves.
+std::optional<std::string> photon_budget_problem(const RenderSettings& settings);
+
 // The memory a render of these settings on `threads` worker threads needs at its peak.
 std::uint64_t estimated_render_bytes(const RenderSettings& settings, int threads);
 
