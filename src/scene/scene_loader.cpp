@@ -10,17 +10,13 @@
 
 #include <algorithm>
 #include <array>
-#include <cctype>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <functional>
-#include <limits>
 #include <map>
 #include <optional>
 #include <span>
 #include <string>
-#include <type_traits>
 #include <vector>
 
 #include "drt/accel/mesh.h"
@@ -33,7 +29,9 @@
 #include "drt/sampling/sampler.h"
 #include "drt/scene/obj_materials.h"
 #include "drt/scene/render_limits.h"
+#include "drt/scene/surface_spec.h"
 #include "drt/scene/texture_cache.h"
+#include "drt/scene/xml_attributes.h"
 #include "drt/shading/image_texture.h"
 #include "drt/shading/texture.h"
 #include "drt/util/file_reader.h"
@@ -46,49 +44,6 @@ namespace {
 
 using tinyxml2::XMLElement;
 
-// ---------------------------------------------------------------------------------------------
-// Suggestions for misspelt names.
-
-// Optimal-string-alignment distance: insertions, deletions, substitutions and swaps of two
-// neighbours each cost one, since a swap ("Nmae") is as common a typo as a wrong letter. Case is
-// ignored, so that "radius" finds "Radius" and "bumpenable" finds "bumpEnable".
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-    const auto same = [](char x, char y) {
-        return std::tolower(static_cast<unsigned char>(x)) ==
-               std::tolower(static_cast<unsigned char>(y));
-    };
-    const std::size_t w = b.size() + 1;
-    std::vector<std::size_t> d((a.size() + 1) * w);
-    for (std::size_t i = 0; i <= a.size(); ++i) d[i * w] = i;
-    for (std::size_t j = 0; j <= b.size(); ++j) d[j] = j;
-    for (std::size_t i = 1; i <= a.size(); ++i) {
-        for (std::size_t j = 1; j <= b.size(); ++j) {
-            std::size_t best =
-                std::min({d[(i - 1) * w + j] + 1, d[i * w + j - 1] + 1,
-                          d[(i - 1) * w + j - 1] + (same(a[i - 1], b[j - 1]) ? 0 : 1)});
-            if (i > 1 && j > 1 && same(a[i - 1], b[j - 2]) && same(a[i - 2], b[j - 1])) {
-                best = std::min(best, d[(i - 2) * w + j - 2] + 1);
-            }
-            d[i * w + j] = best;
-        }
-    }
-    return d[a.size() * w + b.size()];
-}
-
-// The known name closest to `name`, when it is close enough to be what the user meant: about
-// one edit per three characters, so "Radus" gets "Radius" but "Teapot" gets nothing.
-std::optional<std::string_view> nearest(std::string_view name,
-                                        std::span<const std::string_view> known) {
-    const std::size_t allowed = (name.size() + 2) / 3;
-    std::optional<std::string_view> best;
-    std::size_t best_distance = allowed + 1;
-    for (const std::string_view candidate : known) {
-        const std::size_t d = edit_distance(name, candidate);
-        if (d < best_distance) best = candidate, best_distance = d;
-    }
-    return best;
-}
-
 // Every element the format knows, wherever it may stand; an element from this list in the wrong
 // place is reported as misplaced rather than unknown.
 constexpr std::string_view kElementNames[] = {
@@ -96,306 +51,6 @@ constexpr std::string_view kElementNames[] = {
     "Materials", "Lights",   "Objects", "Light",       "Plane",   "Sphere", "MotionBlurPosition",
     "Material",  "Triangle", "Mesh",    "Environment", "Photons",
 };
-
-// ---------------------------------------------------------------------------------------------
-// Numbers: the whole (trimmed) attribute value must be one finite number.
-
-std::string_view trim(std::string_view s) {
-    constexpr std::string_view kSpace = " \t\r\n";
-    const std::size_t first = s.find_first_not_of(kSpace);
-    if (first == std::string_view::npos) return {};
-    return s.substr(first, s.find_last_not_of(kSpace) - first + 1);
-}
-
-// std::errc{} on success; invalid_argument for anything that is not wholly a finite number of
-// type T; result_out_of_range when it is one but T cannot hold it.
-template <class T>
-std::errc parse_whole(std::string_view text, T& out) {
-    // from_chars rejects a leading '+', which people write; "+-1" must stay an error.
-    if (!text.empty() && text.front() == '+') {
-        text.remove_prefix(1);
-        if (!text.empty() && text.front() == '-') return std::errc::invalid_argument;
-    }
-    const char* end = text.data() + text.size();
-    const auto [ptr, ec] = std::from_chars(text.data(), end, out);
-    if (ec != std::errc{}) return ec;
-    if (ptr != end) return std::errc::invalid_argument;
-    if constexpr (std::is_floating_point_v<T>) {
-        if (!std::isfinite(out)) return std::errc::invalid_argument;  // "inf", "nan"
-    }
-    return {};
-}
-
-// ---------------------------------------------------------------------------------------------
-// Where messages go.
-
-class Context {
-  public:
-    explicit Context(std::string file) : file_(std::move(file)) {}
-
-    [[noreturn]] void fail(const XMLElement& element, const std::string& message) const {
-        fail_at(element.GetLineNum(), element.Name(), message);
-    }
-    [[noreturn]] void fail_at(int line, std::string_view element,
-                              const std::string& message) const {
-        throw SceneError(printable(file_ + ":" + std::to_string(std::max(line, 1)) + ": " +
-                                   std::string(element) + ": " + message));
-    }
-    void warn(const XMLElement& element, const std::string& message) {
-        warn_at(element.GetLineNum(), message);
-    }
-    void warn_at(int line, const std::string& message) { warn_in(file_, line, message); }
-    // About a line of another file that the scene reads (an OBJ or MTL file).
-    void warn_in(const std::string& file, int line, const std::string& message) {
-        warnings_.push_back(printable(file + ":" + std::to_string(line) + ": warning: " + message));
-    }
-    void warn_unknown_element(const XMLElement& element, const XMLElement& parent,
-                              std::span<const std::string_view> allowed) {
-        const std::string_view name = element.Name();
-        if (std::ranges::find(kElementNames, name) != std::end(kElementNames)) {
-            warn(element,
-                 "<" + std::string(name) + "> does not belong in <" + parent.Name() + ">; ignored");
-            return;
-        }
-        std::string message = "unknown element <" + std::string(name) + ">";
-        if (const auto guess = nearest(name, allowed))
-            message += "; did you mean <" + std::string(*guess) + ">?";
-        warn(element, message);
-    }
-
-    const std::string& file() const { return file_; }
-    std::vector<std::string> take_warnings() { return std::move(warnings_); }
-
-  private:
-    std::string file_;
-    std::vector<std::string> warnings_;
-};
-
-// ---------------------------------------------------------------------------------------------
-// The attributes of one element. Every accessor records the name it was asked for, so after an
-// element has been read completely, the recorded names are exactly the attributes it knows:
-// anything else on the element is unknown, and the recorded names are the suggestions.
-
-class Attributes {
-  public:
-    Attributes(const XMLElement& element, Context& context)
-        : element_(element), context_(context) {}
-
-    [[noreturn]] void fail(const std::string& message) const { context_.fail(element_, message); }
-
-    std::optional<std::string_view> find(std::string_view name) {
-        known_.push_back(name);
-        const char* value = element_.Attribute(std::string(name).c_str());
-        return value ? std::optional<std::string_view>(value) : std::nullopt;
-    }
-
-    std::string text(std::string_view name) {
-        if (const auto value = find(name)) return std::string(*value);
-        fail_missing(name);
-    }
-    std::string text(std::string_view name, std::string_view fallback) {
-        return std::string(find(name).value_or(fallback));
-    }
-
-    std::optional<double> optional_number(std::string_view name) {
-        const auto value = find(name);
-        if (!value) return std::nullopt;
-        return convert<double>(name, *value, "a number");
-    }
-    double number(std::string_view name) {
-        if (const auto value = optional_number(name)) return *value;
-        fail_missing(name);
-    }
-    double number(std::string_view name, double fallback) {
-        return optional_number(name).value_or(fallback);
-    }
-    Vec3 vec3(std::string_view x, std::string_view y, std::string_view z) {
-        return {number(x), number(y), number(z)};
-    }
-    Vec3 vec3(std::string_view x, std::string_view y, std::string_view z, Vec3 fallback) {
-        return {number(x, fallback.x), number(y, fallback.y), number(z, fallback.z)};
-    }
-    Color color(std::string_view r, std::string_view g, std::string_view b, Color fallback) {
-        return {number(r, fallback.r), number(g, fallback.g), number(b, fallback.b)};
-    }
-
-    template <class Int>
-    Int integer(std::string_view name, Int fallback) {
-        const auto value = find(name);
-        if (!value) return fallback;
-        return convert<Int>(name, *value,
-                            std::is_signed_v<Int> ? "an integer" : "a non-negative integer");
-    }
-    bool flag(std::string_view name, bool fallback) {
-        const auto value = find(name);
-        if (!value) return fallback;
-        const std::string_view t = trim(*value);
-        if (t != "0" && t != "1") {
-            fail(std::string(name) + " must be 0 or 1, got \"" + abbreviated(*value) + "\"");
-        }
-        return t == "1";
-    }
-
-    // Fails with "NAME must be RULE, got VALUE" unless `ok`.
-    void check(bool ok, std::string_view name, std::string_view rule) const {
-        if (!ok) fail(std::string(name) + " must be " + std::string(rule) + ", got " + shown(name));
-    }
-    // A radiance that rays see as it is must fit the float channels of an image.
-    void check_radiance(const Color& c, std::string_view r, std::string_view g,
-                        std::string_view b) const {
-        for (const auto& [value, name] : {std::pair{c.r, r}, {c.g, g}, {c.b, b}}) {
-            check(std::abs(value) <= kLargestPixelValue, name, kLargestPixelValueText);
-        }
-    }
-    static constexpr double kLargestPixelValue = std::numeric_limits<float>::max();
-    static constexpr std::string_view kLargestPixelValueText =
-        "at most 3.40282e+38 (the largest value a float image holds)";
-    // The attribute's value as the user wrote it, for messages.
-    std::string shown(std::string_view name) const {
-        const char* value = element_.Attribute(std::string(name).c_str());
-        return value ? abbreviated(trim(value)) : "(default)";
-    }
-
-    // Call once the element has been read completely.
-    void warn_unknown() {
-        for (const auto* a = element_.FirstAttribute(); a; a = a->Next()) {
-            const std::string_view name = a->Name();
-            if (std::ranges::find(known_, name) != known_.end()) continue;
-            std::string message =
-                "unknown attribute " + quoted(name) + " on <" + element_.Name() + ">";
-            if (const auto guess = nearest(name, known_))
-                message += "; did you mean " + quoted(*guess) + "?";
-            context_.warn(element_, message);
-        }
-    }
-
-  private:
-    static std::string quoted(std::string_view name) {
-        std::string text(1, '\'');
-        text.append(name);
-        text += '\'';
-        return text;
-    }
-
-    [[noreturn]] void fail_missing(std::string_view name) const {
-        fail("missing required attribute " + quoted(name));
-    }
-
-    template <class T>
-    T convert(std::string_view name, std::string_view value, std::string_view kind) const {
-        T out{};
-        const std::errc ec = parse_whole(trim(value), out);
-        if (ec == std::errc{}) return out;
-        const std::string problem = ec == std::errc::result_out_of_range
-                                        ? "is out of range"
-                                        : "is not " + std::string(kind);
-        fail("attribute " + quoted(name) + " " + problem + ": \"" + abbreviated(value) + "\"");
-    }
-
-    const XMLElement& element_;
-    Context& context_;
-    std::vector<std::string_view> known_;
-};
-
-// ---------------------------------------------------------------------------------------------
-// Texture and bump mapping, common to planes and spheres. The texture needs the material's kd,
-// which may not be known until every material has been read.
-
-struct SurfaceSpec {
-    bool textured = false;
-    std::string texture;
-    double texture_scale = 50;
-    Color k2{0.1, 0.1, 0.1};
-    std::optional<BumpMap> bump;
-    // Image textures ("Image textures, UV coordinates, OBJ materials, environment").
-    std::string texture_file, bump_file;  // as written in the scene; empty = none
-    std::shared_ptr<const MipMap> image, height;
-    double bump_strength = 0.3;
-    TextureFilter filter = TextureFilter::kAnisotropic;
-    std::optional<std::array<Vec2, 3>> corner_uv;
-
-    bool image_texture() const { return textured && texture == kImageTexture; }
-
-    // Whether objects of this surface and of `other` look alike in every attribute (images
-    // compared by identity: the texture cache gives one file one image), so that they can share
-    // one object.
-    bool same_as(const SurfaceSpec& other) const {
-        const auto same_bump = [](const std::optional<BumpMap>& a,
-                                  const std::optional<BumpMap>& b) {
-            return a.has_value() == b.has_value() &&
-                   (!a || (a->scale == b->scale && a->strength == b->strength));
-        };
-        const auto same_corners = [](const std::optional<std::array<Vec2, 3>>& a,
-                                     const std::optional<std::array<Vec2, 3>>& b) {
-            if (a.has_value() != b.has_value()) return false;
-            for (std::size_t k = 0; a && k < 3; ++k) {
-                if ((*a)[k].x != (*b)[k].x || (*a)[k].y != (*b)[k].y) return false;
-            }
-            return true;
-        };
-        return textured == other.textured && texture == other.texture &&
-               texture_scale == other.texture_scale && k2.r == other.k2.r && k2.g == other.k2.g &&
-               k2.b == other.k2.b && same_bump(bump, other.bump) &&
-               texture_file == other.texture_file && bump_file == other.bump_file &&
-               image == other.image && height == other.height &&
-               bump_strength == other.bump_strength && filter == other.filter &&
-               same_corners(corner_uv, other.corner_uv);
-    }
-
-    SurfaceDetail build(const Material& material) const {
-        SurfaceDetail detail;
-        if (image) {
-            detail.texture = std::make_shared<const ImageTexture>(image, filter);
-        } else if (textured) {
-            detail.texture = make_texture(texture, material.kd, k2, texture_scale);
-        }
-        detail.bump = bump;
-        if (height)
-            detail.height_map = std::make_shared<const HeightMap>(height, bump_strength, filter);
-        detail.texture_scale = texture_scale;
-        detail.corner_uv = corner_uv;
-        return detail;
-    }
-
-    static constexpr std::string_view kImageTexture = "image";
-};
-
-SurfaceSpec read_surface(Attributes& in) {
-    SurfaceSpec s;
-    s.textured = in.flag("EnableTexture", false);
-    s.texture = in.text("Texture", "checker");
-    s.texture_scale = in.number("TextureScale", 50);
-    in.check(s.texture_scale > 0, "TextureScale", "positive");
-    s.k2 = in.color("k2r", "k2g", "k2b", {0.1, 0.1, 0.1});
-    // Checked even when disabled, so that a misspelt name does not wait to be found until the
-    // texture is switched on.
-    if (s.texture != SurfaceSpec::kImageTexture && !make_texture(s.texture, {}, {}, 1))
-        in.fail("unknown texture '" + abbreviated(s.texture) + "'");
-    if (s.image_texture()) {
-        s.texture_file = in.text("TextureFile");
-    } else {
-        in.find("TextureFile");  // known, unused while the image texture is off
-    }
-    s.bump_file = in.text("BumpFile", "");
-    const std::string filter = in.text("TextureFilter", "anisotropic");
-    if (filter == "trilinear") {
-        s.filter = TextureFilter::kTrilinear;
-    } else if (filter == "bilinear") {
-        s.filter = TextureFilter::kBilinear;
-    } else if (filter != "anisotropic") {
-        in.fail("TextureFilter must be anisotropic, trilinear or bilinear, got \"" +
-                abbreviated(filter) + "\"");
-    }
-
-    const bool bumped = in.flag("bumpEnable", false);
-    BumpMap bump;
-    bump.scale = in.number("BumpScale", bump.scale);
-    in.check(bump.scale > 0, "BumpScale", "positive");
-    bump.strength = in.number("BumpStrength", bump.strength);
-    s.bump_strength = bump.strength;
-    if (bumped && s.bump_file.empty()) s.bump = bump;
-    return s;
-}
 
 // The rule of a limit from limits.h, for Attributes::check: "Width must be at most 65536, got ...".
 std::string at_most(int limit) {
@@ -524,7 +179,7 @@ class SceneReader {
             const auto child =
                 std::ranges::find(children, std::string_view(e->Name()), &Child::name);
             if (child == children.end()) {
-                context_.warn_unknown_element(*e, parent, names);
+                warn_unknown_element(*e, parent, names);
                 continue;
             }
             if (child->setting) note_setting(*e);
@@ -536,7 +191,7 @@ class SceneReader {
     void warn_stray_text(const XMLElement& e) {
         for (const tinyxml2::XMLNode* n = e.FirstChild(); n; n = n->NextSibling()) {
             const tinyxml2::XMLText* text = n->ToText();
-            if (text && !trim(text->Value()).empty()) {
+            if (text && !trimmed(text->Value()).empty()) {
                 context_.warn(e, "text inside <" + std::string(e.Name()) + "> ignored");
                 return;
             }
@@ -550,6 +205,20 @@ class SceneReader {
                                  std::to_string(it->second));
             it->second = e.GetLineNum();
         }
+    }
+
+    void warn_unknown_element(const XMLElement& element, const XMLElement& parent,
+                              std::span<const std::string_view> allowed) {
+        const std::string_view name = element.Name();
+        if (std::ranges::find(kElementNames, name) != std::end(kElementNames)) {
+            context_.warn(element, "<" + std::string(name) + "> does not belong in <" +
+                                       parent.Name() + ">; ignored");
+            return;
+        }
+        std::string message = "unknown element <" + std::string(name) + ">";
+        if (const auto guess = nearest_name(name, allowed))
+            message += "; did you mean <" + std::string(*guess) + ">?";
+        context_.warn(element, message);
     }
 
     // A leaf element has no children; any there are ignored, with a warning.
@@ -851,7 +520,7 @@ class SceneReader {
         static constexpr std::string_view kChildren[] = {"MotionBlurPosition"};
         for (const XMLElement* c = e.FirstChildElement(); c; c = c->NextSiblingElement()) {
             if (std::string_view(c->Name()) != kChildren[0]) {
-                context_.warn_unknown_element(*c, e, kChildren);
+                warn_unknown_element(*c, e, kChildren);
                 continue;
             }
             Attributes at(*c, context_);
@@ -1274,12 +943,12 @@ class SceneReader {
         std::vector<std::string_view> names;
         for (const auto& m : scene_.materials) names.push_back(m->name);
         std::string message = "unknown material '" + abbreviated(name) + "'";
-        if (const auto guess = nearest(name, names))
+        if (const auto guess = nearest_name(name, names))
             message += "; did you mean '" + std::string(*guess) + "'?";
         return message;
     }
 
-    Context context_;
+    LoadContext context_;
     Scene scene_;
     std::map<std::string, int, std::less<>> setting_lines_;
     std::map<std::string, int, std::less<>> material_lines_;
