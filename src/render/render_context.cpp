@@ -232,6 +232,7 @@ struct RenderContext::PixelRun {
     std::mutex mutex;
     RayCounts helpers_rays;    // guarded by mutex
     std::exception_ptr error;  // the first a helper threw; guarded by mutex
+    bool stopped = false;      // a helper left a pixel unfinished for a stop; guarded by mutex
 };
 
 bool RenderContext::render_run(const std::shared_ptr<PixelRun>& run, Workbench* bench,
@@ -259,18 +260,21 @@ bool RenderContext::render_run(const std::shared_ptr<PixelRun>& run, Workbench* 
         } opened(bench, run);
         while (const auto k = run->take()) {
             if (stop.stop_requested()) return false;
-            run->pixels[run->rendered[*k]] =
-                render_pixel(run->request, run->x(*k), run->y(*k), run->path, scratch, rays);
+            auto pixel =
+                render_pixel(run->request, run->x(*k), run->y(*k), run->path, scratch, rays, stop);
+            if (!pixel) return false;
+            run->pixels[run->rendered[*k]] = *pixel;
             ++own;
         }
     }
-    // Every pixel is handed out: wait for those the helpers took. A helper renders every pixel
-    // it takes, stop or not, so the count comes.
+    // Every pixel is handed out: wait for those the helpers took. A helper counts every pixel it
+    // takes, finished or left for a stop, so the count comes.
     const std::size_t helped = run->rendered.size() - own;
     for (std::size_t done; (done = run->helped.load(std::memory_order_acquire)) < helped;) {
         run->helped.wait(done, std::memory_order_acquire);
     }
     if (run->error) std::rethrow_exception(run->error);
+    if (run->stopped) return false;
     rays += run->helpers_rays;
     return true;
 }
@@ -362,9 +366,12 @@ std::size_t RenderContext::help(Workbench& bench, const std::stop_token& stop) c
             if (!k) break;
             RayCounts rays;
             std::exception_ptr error;
+            bool stopped = false;
             try {
-                run->pixels[run->rendered[*k]] =
-                    render_pixel(run->request, run->x(*k), run->y(*k), run->path, scratch, rays);
+                auto pixel = render_pixel(run->request, run->x(*k), run->y(*k), run->path, scratch,
+                                          rays, stop);
+                if (pixel) run->pixels[run->rendered[*k]] = *pixel;
+                stopped = !pixel;
             } catch (...) {
                 error = std::current_exception();
             }
@@ -372,6 +379,7 @@ std::size_t RenderContext::help(Workbench& bench, const std::stop_token& stop) c
                 const std::lock_guard lock(run->mutex);
                 run->helpers_rays += rays;
                 if (error && !run->error) run->error = error;
+                run->stopped = run->stopped || stopped;
             }
             // Counted even when it threw, so that the owner does not wait for it forever.
             run->helped.fetch_add(1, std::memory_order_release);
@@ -465,32 +473,47 @@ bool RenderContext::render_again(const RenderRequest& request, const Tile& tile,
     return true;
 }
 
-RenderContext::Pixel RenderContext::render_pixel(const RenderRequest& request, int x, int y,
-                                                 std::uint64_t path, Scratch& scratch,
-                                                 RayCounts& rays) const {
-    return request.adaptive ? adaptive_pixel(request, x, y, path, scratch, rays)
-                            : plain_pixel(request, x, y, path, scratch, rays);
+std::optional<RenderContext::Pixel> RenderContext::render_pixel(const RenderRequest& request, int x,
+                                                                int y, std::uint64_t path,
+                                                                Scratch& scratch, RayCounts& rays,
+                                                                const std::stop_token& stop) const {
+    return request.adaptive ? adaptive_pixel(request, x, y, path, scratch, rays, stop)
+                            : plain_pixel(request, x, y, path, scratch, rays, stop);
 }
 
-RenderContext::Pixel RenderContext::plain_pixel(const RenderRequest& request, int x, int y,
-                                                std::uint64_t path, Scratch& scratch,
-                                                RayCounts& rays) const {
+bool RenderContext::sample(const RenderRequest& request, int x, int y, PixelSample s,
+                           std::span<Color> out, RayCounts& rays,
+                           const std::stop_token& stop) const {
+    for (std::size_t first = 0; first < out.size(); first += kSamplesBetweenStops) {
+        if (first > 0 && stop.stop_requested()) return false;
+        const std::span<Color> part =
+            out.subspan(first, std::min(kSamplesBetweenStops, out.size() - first));
+        integrator(request).sample_pixel(x, y, s, part, rays);
+        s.index += static_cast<std::uint32_t>(part.size());
+    }
+    return true;
+}
+
+std::optional<RenderContext::Pixel> RenderContext::plain_pixel(const RenderRequest& request, int x,
+                                                               int y, std::uint64_t path,
+                                                               Scratch& scratch, RayCounts& rays,
+                                                               const std::stop_token& stop) const {
     const auto spp = static_cast<std::uint32_t>(request.samples);
     const PixelSample s{request.seed, static_cast<std::uint32_t>(y * scene_.settings.width + x), 0,
                         spp, path};
     scratch.colors.resize(spp);
-    integrator(request).sample_pixel(x, y, s, scratch.colors, rays);
+    if (!sample(request, x, y, s, scratch.colors, rays, stop)) return std::nullopt;
     Color sum;
     for (const Color& c : scratch.colors) sum += c;
     if (sampler_->independent() || !plan(request).effects.antialiasing || !request.estimate_error) {
-        return {sum / spp, pixel_spread(scratch.colors), spp, false};
+        return Pixel{sum / spp, pixel_spread(scratch.colors), spp, false};
     }
     // The samples' places in the pixel, as the integrator drew them: the strata they fell in.
     // Only for an estimate someone reads: it costs a sort of the samples.
     scratch.positions.resize(spp);
     sampler_->get_2d_run(s, dim::kPixel, scratch.positions);
-    return {sum / spp, strata_spread(scratch.positions, scratch.colors, scratch.strata), spp,
-            false};
+    return Pixel{sum / spp, strata_spread(scratch.positions, scratch.colors, scratch.strata), spp,
+                 false};
 }
 
 // Rounds of as many samples as taken so far, until the standard error of the mean luminance is
@@ -498,9 +521,9 @@ RenderContext::Pixel RenderContext::plain_pixel(const RenderRequest& request, in
 // pattern of the round's size, on its own ray-tree path, in each round (the first round is
 // exactly a plain render at the minimum count). A second render (`path` not 0) does all that on
 // paths of its own.
-RenderContext::Pixel RenderContext::adaptive_pixel(const RenderRequest& request, int x, int y,
-                                                   std::uint64_t path, Scratch& scratch,
-                                                   RayCounts& rays) const {
+std::optional<RenderContext::Pixel> RenderContext::adaptive_pixel(
+    const RenderRequest& request, int x, int y, std::uint64_t path, Scratch& scratch,
+    RayCounts& rays, const std::stop_token& stop) const {
     const auto spp = static_cast<std::uint32_t>(request.samples);
     const AdaptiveSampling adaptive = *request.applied_adaptive();
     const auto min_spp = static_cast<std::uint32_t>(adaptive.min_samples);
@@ -521,7 +544,7 @@ RenderContext::Pixel RenderContext::adaptive_pixel(const RenderRequest& request,
         s.index = extensible ? n : 0;
         s.pass_base = extensible ? 0 : n;
         scratch.colors.resize(batch);
-        integrator(request).sample_pixel(x, y, s, scratch.colors, rays);
+        if (!sample(request, x, y, s, scratch.colors, rays, stop)) return std::nullopt;
         for (const Color& c : scratch.colors) {
             sum += c;
             luminances.push_back(luminance(c));
@@ -534,7 +557,7 @@ RenderContext::Pixel RenderContext::adaptive_pixel(const RenderRequest& request,
         }
     }
     const auto n = static_cast<std::uint32_t>(luminances.size());
-    return {sum / n, pixel_spread(scratch.taken), n, converged};
+    return Pixel{sum / n, pixel_spread(scratch.taken), n, converged};
 }
 
 std::vector<Tile> costly_first(const RenderContext& context, const RenderRequest& request,

@@ -1,17 +1,24 @@
 // The cost guess that orders the tiles: shaded rays the probes trace, scaled to the tile, and the
 // order it gives (which changes no pixel: renderer_test.cpp renders tiles in any order); requests
 // against one context: without the error estimate, one pixel per block, listed pixels paired;
-// a tile's pixels shared with a helping thread.
+// a tile's pixels shared with a helping thread; a pixel's samples in parts, and a stop heard
+// within a pixel.
 #include "drt/render/render_context.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <optional>
+#include <stop_token>
+#include <string>
 #include <thread>
 #include <utility>
 #include <vector>
 
+#include "drt/render/pixel_integrator.h"
+#include "drt/render/render_plan.h"
+#include "drt/sampling/sampler.h"
 #include "drt/scene/light.h"
 #include "test_scenes.h"
 
@@ -164,6 +171,72 @@ TEST(RenderContext, HelpersRenderATilesPixelsAsItsOwnThreadWould) {
             EXPECT_EQ(shared->rays.total(), alone.rays.total());
         }
         EXPECT_GT(helped, 0u);
+    }
+}
+
+// A pixel's samples are rendered kSamplesBetweenStops at a time (RenderContext::sample), which
+// gives the bits of one run only because each sample is a function of its own index: for both
+// integrators and every sampler, a run of 700 samples and the same samples in parts agree.
+TEST(RenderContext, APixelsSamplesInPartsAreThoseOfOneRun) {
+    for (const std::string name : {"thesis/test6.xml", "gi/cornell-box.xml"}) {
+        for (const std::string sampler_name : {"stratified", "sobol", "random"}) {
+            SCOPED_TRACE(name + " " + sampler_name);
+            Scene scene = testing::scaled_scene(name, 8, 700);
+            scene.settings.sampler = sampler_name;
+            const RenderPlan plan = plan_render(scene);
+            const Bvh bvh(scene.objects);
+            const auto sampler = make_sampler(sampler_name);
+            const auto integrator = make_integrator(scene, plan, bvh, *sampler);
+            const int x = 3, y = scene.settings.height / 2;
+            PixelSample s{5, static_cast<std::uint32_t>(y * scene.settings.width + x), 0, 700};
+            std::vector<Color> whole(700), parts(700);
+            RayCounts rays_whole, rays_parts;
+            integrator->sample_pixel(x, y, s, whole, rays_whole);
+            for (const std::size_t part : {256u, 256u, 188u}) {
+                integrator->sample_pixel(x, y, s, std::span(parts).subspan(s.index, part),
+                                         rays_parts);
+                s.index += static_cast<std::uint32_t>(part);
+            }
+            for (std::size_t i = 0; i < whole.size(); ++i) {
+                ASSERT_EQ(whole[i].r, parts[i].r) << i;
+                ASSERT_EQ(whole[i].g, parts[i].g) << i;
+                ASSERT_EQ(whole[i].b, parts[i].b) << i;
+            }
+            EXPECT_EQ(rays_whole.total(), rays_parts.total());
+            EXPECT_GT(rays_whole.total(), 700u);
+        }
+    }
+}
+
+// A stop is heard between a pixel's samples, not only between its pixels: a tile of one pixel
+// of 65,536 samples (most of a second, more under the sanitizers) stopped 20 ms in
+// comes back empty, plainly and adaptively; before, the pixel was finished, and with it the tile.
+TEST(RenderContext, AStopIsHeardWithinAPixel) {
+    using namespace std::chrono_literals;
+    Scene scene = testing::scaled_scene("thesis/test6.xml", 1, 65536);
+    scene.settings.shadow_rays = 512;  // a pixel of most of a second: the stop comes inside it
+    ASSERT_EQ(scene.settings.height, 1);
+    const RenderContext context(scene);
+    RenderRequest plain = RenderRequest::whole_image(scene.settings);
+    plain.estimate_error = false;
+    RenderRequest adaptive = plain;
+    adaptive.adaptive = AdaptiveSampling{1e-12, 16};  // never met: rounds up to 65,536
+    for (const RenderRequest& request : {plain, adaptive}) {
+        SCOPED_TRACE(request.adaptive ? "adaptive" : "plain");
+        std::stop_source stop;
+        const auto start = std::chrono::steady_clock::now();
+        std::optional<TileBuffer> tile;
+        {
+            const std::jthread stopper([&] {
+                std::this_thread::sleep_for(20ms);
+                stop.request_stop();
+            });
+            tile = context.render_tile(context.tiles()[0], request, stop.get_token());
+        }
+        EXPECT_FALSE(tile)
+            << "finished in "
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
+            << " s";
     }
 }
 

@@ -135,13 +135,23 @@ class RenderContext {
 
     const PixelIntegrator& integrator(const RenderRequest& request) const;
     // One pixel on ray-tree path `path` (0 for the image's own render), adaptively or not; they
-    // add their rays to `rays`.
-    Pixel render_pixel(const RenderRequest& request, int x, int y, std::uint64_t path,
-                       Scratch& scratch, RayCounts& rays) const;
-    Pixel plain_pixel(const RenderRequest& request, int x, int y, std::uint64_t path,
-                      Scratch& scratch, RayCounts& rays) const;
-    Pixel adaptive_pixel(const RenderRequest& request, int x, int y, std::uint64_t path,
-                         Scratch& scratch, RayCounts& rays) const;
+    // add their rays to `rays`. Nothing if `stop` came first.
+    std::optional<Pixel> render_pixel(const RenderRequest& request, int x, int y,
+                                      std::uint64_t path, Scratch& scratch, RayCounts& rays,
+                                      const std::stop_token& stop) const;
+    std::optional<Pixel> plain_pixel(const RenderRequest& request, int x, int y, std::uint64_t path,
+                                     Scratch& scratch, RayCounts& rays,
+                                     const std::stop_token& stop) const;
+    std::optional<Pixel> adaptive_pixel(const RenderRequest& request, int x, int y,
+                                        std::uint64_t path, Scratch& scratch, RayCounts& rays,
+                                        const std::stop_token& stop) const;
+    // The pixel's camera samples s.index, s.index + 1, ... into `out`, kSamplesBetweenStops at a
+    // time, so that a stop is heard within a few milliseconds rather than a pixel of 65,536
+    // samples (seconds); every sample is a function of its own index, so the bits are those of
+    // one run. False if `stop` came first.
+    bool sample(const RenderRequest& request, int x, int y, PixelSample s, std::span<Color> out,
+                RayCounts& rays, const std::stop_token& stop) const;
+    static constexpr std::size_t kSamplesBetweenStops = 256;
     // The pixels of `tile` that renders() picks, as indices row by row into the tile.
     std::vector<std::size_t> rendered_in(const Tile& tile, const RenderRequest& request) const;
     // Renders the run's pixels on this thread and, with a bench, on any helping; adds their
