@@ -6,6 +6,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "cli_render.h"
@@ -18,6 +19,18 @@ namespace drt::cli {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// 130 and 143 are SIGINT's and SIGTERM's (128 + the signal).
+std::string_view status_word(int status) {
+    if (status == kOk) return "ok";
+    if (status == kFailed) return "failed";
+    if (status == kBadInput) return "bad input";
+    return "interrupted";
+}
+
+}  // namespace
+
 void print_summary(const std::vector<SceneOutcome>& outcomes, std::ostream& out) {
     out << std::left << std::setw(32) << "scene" << std::right << std::setw(11) << "size"
         << std::setw(9) << "samples" << std::setw(10) << "seconds" << std::setw(10) << "Mrays/s"
@@ -29,11 +42,7 @@ void print_summary(const std::vector<SceneOutcome>& outcomes, std::ostream& out)
             << std::right << std::setw(11) << size.str() << std::setw(9)
             << (o.samples ? std::to_string(o.samples) : "") << std::fixed << std::setprecision(2)
             << std::setw(10) << o.seconds << std::setw(10) << o.mrays_per_second
-            << std::defaultfloat << "  "
-            << (o.status == kOk       ? "ok"
-                : o.status == kFailed ? "failed"
-                                      : "bad input")
-            << "\n";
+            << std::defaultfloat << "  " << status_word(o.status) << "\n";
     }
 }
 
@@ -52,7 +61,7 @@ void BatchReport::add_to(CLI::App& app) {
         ->needs(refs);
     app.add_option("--max-rmse", max_rmse,
                    "Batch report: a case fails when its RMSE exceeds X (default 0: any change)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(finite_non_negative())
         ->needs(refs);
 }
 

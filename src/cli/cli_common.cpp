@@ -42,16 +42,30 @@ CLI::Validator integer_in(long long lowest, unsigned long long limit) {
         "INT in [" + std::to_string(lowest) + ", " + std::to_string(limit) + "]");
 }
 
-CLI::Validator finite_positive() {
+namespace {
+
+CLI::Validator finite_at_least_zero(bool zero_allowed) {
     return CLI::Validator(
-        [](std::string& text) -> std::string {
+        [zero_allowed](std::string& text) -> std::string {
             char* end = nullptr;
             const double v = std::strtod(text.c_str(), &end);
-            const bool ok = !text.empty() && *end == '\0' && std::isfinite(v) && v > 0;
+            const bool ok = !text.empty() && *end == '\0' && std::isfinite(v) &&
+                            (v > 0 || (zero_allowed && v == 0));
+            const std::string rule = zero_allowed ? "non-negative" : "positive";
             return ok ? std::string()
-                      : "must be a finite positive number, got " + abbreviated(text);
+                      : "must be a finite " + rule + " number, got " + abbreviated(text);
         },
-        "POSITIVE");
+        zero_allowed ? "NONNEGATIVE" : "POSITIVE");
+}
+
+}  // namespace
+
+CLI::Validator finite_positive() {
+    return finite_at_least_zero(false);
+}
+
+CLI::Validator finite_non_negative() {
+    return finite_at_least_zero(true);
 }
 
 void Overrides::add_to(CLI::App& app) {

@@ -54,6 +54,9 @@ CLI::Validator integer_in(long long lowest, unsigned long long limit);
 
 // A finite number above zero (CLI::PositiveNumber lets "nan" and "inf" through).
 CLI::Validator finite_positive();
+// A finite number of zero or more (CLI::NonNegativeNumber's message prints a double's bounds in
+// full, 309 digits).
+CLI::Validator finite_non_negative();
 
 // Parses a subcommand's arguments: its help on `out` (exit kOk), or a parse error on `err` with a
 // pointer to `COMMAND --help` (exit kBadInput); nothing when the command should go on.

@@ -23,7 +23,7 @@ int compare_command(int argc, const char* const* argv, std::ostream& out, std::o
     app.add_option("A", a, "First image")->required();
     app.add_option("B", b, "Second image")->required();
     app.add_option("--max-rmse", max_rmse, "Exit 1 when the RMSE exceeds X")
-        ->check(CLI::NonNegativeNumber);
+        ->check(finite_non_negative());
     app.add_option("--min-psnr", min_psnr, "Exit 1 when the PSNR falls below Y (dB)");
     app.add_option("--diff", diff,
                    "Write a false-colour difference image to D (.png, .bmp, .pfm, .exr)");

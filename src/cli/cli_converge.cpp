@@ -49,7 +49,8 @@ struct ConvergeFlags {
         app.add_option("--save-reference", save_reference,
                        "Write the rendered reference to FILE (.pfm or .exr)");
         app.add_option("--csv", csv,
-                       "Write spp,seconds,rmse,relmse,mean_spp,cpu_seconds,fitted rows to FILE");
+                       "Write spp,seconds,rmse,relmse,mean_spp,cpu_seconds,fitted,"
+                       "estimated_rmse,estimated_relmse rows to FILE");
         adaptive.add_to(app);
         app.add_option("--threads", threads, "Worker threads (default: all cores)")
             ->check(integer_in(1, kMaxThreads));

@@ -465,7 +465,7 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
     job.goal.add_to(app, {threshold, checkpoint, aov});
     app.add_option("--checkpoint-every", job.checkpoint_seconds,
                    "Seconds between checkpoint writes (default 30)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(finite_non_negative());
     // For tests: stop as SIGINT would once N tiles are done.
     app.add_option("--stop-after-tiles", job.stop_after_tiles)->group("");
     // For bench/mpi.sh: hand tiles out row by row, to measure what costly-first saves.

@@ -198,7 +198,11 @@ ErrorEstimate estimate_error(const Image& image, const Image& spread, const Erro
         for (std::size_t i = p; i < p + 3; ++i) {
             const double v = e.scale * spread.rgb[i], x = image.rgb[i];
             if (!std::isfinite(v)) {
-                e.unavailable = "a pixel took fewer than 2 samples";
+                // A pixel of one sample has an infinite spread, and so does one whose samples
+                // differ by more than a float holds.
+                e.unavailable =
+                    "a pixel's spread is not finite (fewer than 2 samples, or radiance past the "
+                    "float range)";
                 return e;
             }
             mse += v;

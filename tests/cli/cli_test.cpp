@@ -587,6 +587,13 @@ TEST_F(CliTest, BatchRendersEveryGoodSceneReportsAndExitsWithTheHighestStatus) {
     // All good: exit 0; an existing folder is fine.
     const Outcome ok = run({"a.xml", "c.xml", "-o", "out/renders", "-q"});
     EXPECT_EQ(ok.status, 0) << ok.err;
+
+    // An interrupt ends the batch with the scene in hand, which the summary says.
+    const Outcome stopped =
+        run({"a.xml", "c.xml", "-o", "out/stopped/", "-q", "--stop-after-tiles", "1"});
+    EXPECT_EQ(stopped.status, 130) << stopped.err;
+    EXPECT_TRUE(regex_search(stopped.out, "\na\\.xml .* interrupted\n$")) << stopped.out;
+    EXPECT_EQ(stopped.out.find("c.xml"), std::string::npos) << stopped.out;
 }
 
 TEST_F(CliTest, BatchStatsListEveryRenderedScene) {
@@ -980,6 +987,17 @@ TEST_F(CliTest, NonFiniteNumbersAndNegativeSeedsAreRefusedLikeTheScenesOwn) {
     EXPECT_EQ(range.err,
               "drt: --scale: must be a finite positive number, got -1e308\n"
               "Run 'drt --help' for usage.\n");
+    // Options that may be zero say so, in the same words.
+    const Outcome every = run({"scene.xml", "--checkpoint-every", "-1"});
+    EXPECT_EQ(every.status, 2);
+    EXPECT_EQ(every.err,
+              "drt: --checkpoint-every: must be a finite non-negative number, got -1\n"
+              "Run 'drt --help' for usage.\n");
+    const Outcome rmse = run({"compare", "a.png", "b.png", "--max-rmse", "inf"});
+    EXPECT_EQ(rmse.status, 2);
+    EXPECT_EQ(rmse.err,
+              "drt compare: --max-rmse: must be a finite non-negative number, got inf\n"
+              "Run 'drt compare --help' for usage.\n");
 }
 
 TEST_F(CliTest, UnwritableStatsIsRefusedBeforeTheImageReplacesTheOutput) {
@@ -1035,6 +1053,10 @@ TEST_F(CliTest, NonFinitePixelsLeaveTheOutputAsItWasAndKeepTheImageBesideIt) {
         std::count_if(kept.rgb.begin(), kept.rgb.end(), [](float v) { return !std::isfinite(v); });
     EXPECT_GT(bad, 0);
     EXPECT_NE(r.err.find("drt: wrote out.nonfinite.pfm ("), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("estimated RMSE n/a (a pixel's spread is not finite (fewer than 2 "
+                         "samples, or radiance past the float range))"),
+              std::string::npos)
+        << r.err;
     EXPECT_NE(r.err.find("drt: bright.xml: " + std::to_string(bad) +
                          " of 1152 channel values are not finite"),
               std::string::npos)
