@@ -48,10 +48,13 @@ std::string format_duration(double seconds) {
 }
 
 // A one-line progress display on a terminal: percent, elapsed and estimated remaining time.
+// It never goes back: the share of a tile's pixels counts until the tile is handed in, and a
+// tile between the two counts nothing for a moment.
 class ProgressDisplay {
   public:
     ProgressDisplay(std::ostream& err, std::string label) : err_(err), label_(std::move(label)) {}
     void operator()(double done) {
+        done = shown_ = std::max(shown_, done);
         const double elapsed =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
         const double left = done > 0 ? elapsed * (1 - done) / done : 0;
@@ -69,6 +72,7 @@ class ProgressDisplay {
     std::ostream& err_;
     std::string label_;
     std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+    double shown_ = 0;
 };
 
 // --target-error and --time-limit: rounds of renders until the goal (goal_render.h).

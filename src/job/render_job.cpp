@@ -140,8 +140,14 @@ RenderJobResult run_job(const RenderContext& context, const RenderRequest& asked
         }
         todo = image->missing();
         if (options.on_progress) {
-            run.on_progress = [&](double) {
-                options.on_progress(double(image->tiles_done()) / double(image->tile_count()));
+            // This process's share counts the pixels handed out of its tiles in hand
+            // (render_tiles); the image counts the tiles resumed and those other processes sent.
+            const double before = double(image->tiles_done());
+            const double share = double(todo.size());
+            const double all = double(image->tile_count());
+            run.on_progress = [&, before, share, all](double done) {
+                options.on_progress(std::max(double(image->tiles_done()), before + done * share) /
+                                    all);
             };
         }
     }

@@ -216,10 +216,10 @@ struct RenderContext::PixelRun {
         const std::size_t k = next.fetch_add(1, std::memory_order_relaxed);
         return k < rendered.size() ? std::optional(k) : std::nullopt;
     }
-    std::size_t left() const {
-        const std::size_t handed = next.load(std::memory_order_relaxed);
-        return handed < rendered.size() ? rendered.size() - handed : 0;
+    std::size_t handed() const {
+        return std::min(next.load(std::memory_order_relaxed), rendered.size());
     }
+    std::size_t left() const { return rendered.size() - handed(); }
 
     const RenderRequest& request;
     const Tile tile;
@@ -234,6 +234,16 @@ struct RenderContext::PixelRun {
     std::exception_ptr error;  // the first a helper threw; guarded by mutex
     bool stopped = false;      // a helper left a pixel unfinished for a stop; guarded by mutex
 };
+
+double RenderContext::Workbench::tiles_in_hand() const {
+    const std::lock_guard lock(mutex_);
+    double tiles = 0;
+    for (const auto& run : open_) {
+        if (run->path == 0 && !run->rendered.empty())
+            tiles += double(run->handed()) / double(run->rendered.size());
+    }
+    return tiles;
+}
 
 bool RenderContext::render_run(const std::shared_ptr<PixelRun>& run, Workbench* bench,
                                const std::stop_token& stop, Scratch& scratch,

@@ -27,10 +27,13 @@ int render_tiles(const RenderContext& context, const RenderRequest& request, Til
     const int threads = source.size() > 0 ? worker_threads(options.threads) : 1;
     std::atomic<std::size_t> tiles_done{0};
     const double total = static_cast<double>(std::max<std::size_t>(1, source.size()));
-    const auto progress = [&] { options.on_progress(double(tiles_done.load()) / total); };
-    // A thread out of tiles helps render the pixels of those still in hand.
+    // A thread out of tiles helps render the pixels of those still in hand. On one thread the
+    // bench only shows the progress within them.
     RenderContext::Workbench bench;
-    RenderContext::Workbench* const shared = threads > 1 ? &bench : nullptr;
+    const auto progress = [&] {
+        const double done = double(tiles_done.load());
+        options.on_progress(std::min(done + bench.tiles_in_hand(), total) / total);
+    };
     run_on_threads(
         threads,
         [&](const std::atomic<bool>& failed) {
@@ -44,7 +47,7 @@ int render_tiles(const RenderContext& context, const RenderRequest& request, Til
                         break;
                     }
                     std::optional<TileBuffer> done =
-                        context.render_tile(*tile, request, options.stop, shared);
+                        context.render_tile(*tile, request, options.stop, &bench);
                     if (!done) {
                         source.give_back(*tile);
                         break;
@@ -53,7 +56,7 @@ int render_tiles(const RenderContext& context, const RenderRequest& request, Til
                     tiles_done.fetch_add(1, std::memory_order_relaxed);
                 }
             }
-            if (out_of_tiles && shared) context.help(*shared, options.stop);
+            if (out_of_tiles && threads > 1) context.help(bench, options.stop);
         },
         options.on_progress ? std::function<void()>(progress) : nullptr);
     if (options.on_progress) progress();

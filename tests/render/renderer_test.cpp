@@ -428,5 +428,31 @@ TEST(Renderer, ProgressEndsAtOneAndCountsTilesAlreadyDone) {
     EXPECT_EQ(reported.back(), 1.0);
 }
 
+// Progress moves within a tile: a one-tile render of 16,384 samples a pixel (seconds) reports a
+// share above 0 and below 1 while the tile is in hand, which is stopped once it does.
+TEST(Renderer, ProgressCountsThePixelsOfTheTileInHand) {
+    Scene scene = small_scene("thesis/test6.xml", 16);
+    scene.settings.samples = 16384;
+    const RenderContext context(scene);
+    ASSERT_EQ(context.tiles().size(), 1u);
+    RenderRequest request = RenderRequest::whole_image(scene.settings);
+    request.estimate_error = false;
+    for (const int threads : {1, 2}) {
+        SCOPED_TRACE(threads);
+        ImageSink sink(scene.settings.width, scene.settings.height, context.tiles());
+        std::stop_source stop;
+        std::vector<double> reported;
+        RenderOptions options = on_threads(threads);
+        options.stop = stop.get_token();
+        options.on_progress = [&](double done) {
+            reported.push_back(done);
+            if (done > 0 && done < 1) stop.request_stop();
+        };
+        complete_render(context, request, sink, options);
+        EXPECT_TRUE(std::ranges::any_of(reported, [](double d) { return d > 0 && d < 1; }));
+        EXPECT_EQ(sink.tiles_done(), 0u);
+    }
+}
+
 }  // namespace
 }  // namespace drt

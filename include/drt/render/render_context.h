@@ -85,9 +85,14 @@ class RenderContext {
             Workbench& bench_;
         };
 
+        // How much of the tiles open here is handed out, in tiles (a tile half done adds 0.5): a
+        // progress display's steps within tiles, which at thousands of samples a pixel take
+        // minutes. The estimate's second renders of a tile count nothing.
+        double tiles_in_hand() const;
+
       private:
         friend class RenderContext;
-        std::mutex mutex_;
+        mutable std::mutex mutex_;
         std::condition_variable_any changed_;  // a tile opened, or a taker left
         std::vector<std::shared_ptr<PixelRun>> open_;
         int takers_ = 0;
@@ -95,7 +100,7 @@ class RenderContext {
 
     // Renders the pixels of `tile` that `request` picks. Safe to call from several threads.
     TileBuffer render_tile(const Tile& tile, const RenderRequest& request) const;
-    // The same, abandoned between two pixels once `stop` is requested: a tile of thousands of
+    // The same, abandoned within 256 samples once `stop` is requested: a tile of thousands of
     // samples a pixel takes seconds, too long to keep a person who stopped the render waiting.
     // With a workbench, the tile's pixels are open there to helpers while it renders them.
     std::optional<TileBuffer> render_tile(const Tile& tile, const RenderRequest& request,
