@@ -125,7 +125,7 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
         }
 
         const Material& m = hit->object->material();
-        const SurfaceHit surface = hit->object->surface_at(ray, *hit);
+        const SurfaceHit surface = surface_of(ray, *hit, depth, camera_, scene_.settings.samples);
         const auto [outside, geometric, shading, above] = facing_normals(surface, ray.dir);
 
         if (m.emits()) {

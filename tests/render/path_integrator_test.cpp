@@ -597,5 +597,20 @@ TEST(PathIntegrator, ThesisLightGivesTheDistributedIntegratorsDirectLight) {
     }
 }
 
+// Camera rays filter image textures over their footprint in both integrators: the far tiles of
+// a floor seen at a grazing angle (hundreds of tiles a pixel) look the same in both, where a
+// path integrator reading the finest level would show them speckled.
+TEST(PathIntegrator, CameraRaysFilterImageTexturesAsTheDistributedIntegratorsDo) {
+    Scene scene = testing::scaled_scene("assets/tiled-floor.xml", 48, 4);
+    scene.ambient = {};
+    scene.background = {};  // a point light's direct light alone, the same in both
+    const RenderResult distributed = render_with(scene);
+    scene.settings.integrator = IntegratorKind::kPath;
+    const RenderResult path = render_with(scene);
+    for (std::size_t i = 0; i < path.image.rgb.size(); ++i) {
+        EXPECT_NEAR(path.image.rgb[i], distributed.image.rgb[i], 1e-6) << i;
+    }
+}
+
 }  // namespace
 }  // namespace drt
