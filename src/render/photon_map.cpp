@@ -309,12 +309,13 @@ bool PhotonMaps::trace_one(std::uint64_t key, Photon& out) const {
                 std::upper_bound(cdf.begin(), cdf.end(), x) - cdf.begin(), cdf.size() - 1);
             const double lo = t == 0 ? 0.0 : cdf[t - 1];
             const double v = std::clamp((x - lo) / (cdf[t] - lo), 0.0, std::nextafter(1.0, 0.0));
-            const auto triangle = static_cast<std::uint32_t>(t);
-            const auto c = e.mesh->corners(triangle);
+            // The emitter's own triangles: for a part of a shared mesh, not the mesh's t-th.
+            const Emitters::Emitter::Triangle& triangle = e.triangles[t];
+            const auto& c = triangle.corners;
             const double su = std::sqrt(v);
             const double b1 = 1 - su, b2 = u(kEmitB) * su;
             const Vec3 point = e.path->at(time) + (c[0] * (1 - b1 - b2) + c[1] * b1 + c[2] * b2);
-            const Vec3 face = e.mesh->geometric_normal(triangle);
+            const Vec3 face = triangle.normal;
             const Aim a = aim(point, {u(kEmitC), u(kEmitD)}, u(kSide));
             const double cosine = std::abs(dot(face, a.dir));  // both sides emit
             if (!(cosine > 0)) return false;

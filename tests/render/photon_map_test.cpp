@@ -382,6 +382,43 @@ TEST(PhotonMap, ClearPaneLetsPhotonsBringTheDirectLightInBothIntegrators) {
     EXPECT_NEAR(mean_of(pane_scene("path", true, true, 32)) / open, 1, 0.02);
 }
 
+// An emitting <Triangle> grouped into one mesh with the pane's triangles (its part comes
+// second): its photons leave from its own triangles, not from the mesh's first ones (the pane's),
+// and bring the direct light through the pane as the clear pane's test does for a sphere light.
+std::string lamp_and_pane_scene(bool pane, bool photons, int samples) {
+    // Two triangles: the square of half-side h about (x0, y, 0).
+    const auto quad = [](double y, double h, double x0, const std::string& material) {
+        const auto corner = [y](const char* name, double x, double z) {
+            const std::string n(name);
+            return " " + n + "x=\"" + std::to_string(x) + "\" " + n + "y=\"" + std::to_string(y) +
+                   "\" " + n + "z=\"" + std::to_string(z) + "\"";
+        };
+        return "<Triangle" + corner("A", x0 - h, -h) + corner("B", x0 + h, -h) +
+               corner("C", x0 + h, h) + " Material=\"" + material + "\"/><Triangle" +
+               corner("A", x0 - h, -h) + corner("B", x0 + h, h) + corner("C", x0 - h, h) +
+               " Material=\"" + material + "\"/>";
+    };
+    return R"(<Scene><Image Width="8" Height="8"/>
+      <Render Samples=")" +
+           std::to_string(samples) + R"(" MaxDepth="4" Sampler="random"/>)" +
+           (photons ? R"(<Photons Count="20000" Radius="0.2"/>)" : "") +
+           R"(<Camera Ex="0" Ey="1" Ez="0" Lx="0" Ly="0" Lz="0" Ux="0" Uy="0" Uz="1" Fov="90"/>
+      <Materials><Floor diffuse="1" kdr="0.5" kdg="0.5" kdb="0.5"/>
+        <Pane transmitt="1" ktr="1" ktg="1" ktb="1" index="1"/>
+        <Lamp ker="40" keg="40" keb="40"/></Materials>
+      <Plane Px="0" Py="0" Pz="0" Vu="0" Vv="1" Vw="0" Material="Floor"/>)" +
+           (pane ? quad(1.5, 4, 0, "Pane") : "") + quad(2, 0.25, 0.3, "Lamp") + "</Scene>";
+}
+
+TEST(PhotonMap, AnEmittingPartOfASharedMeshSendsItsPhotonsFromItsOwnTriangles) {
+    const Scene grouped = from_xml(lamp_and_pane_scene(true, false, 1));
+    ASSERT_EQ(grouped.objects.size(), 3u);  // the floor, and the mesh's two parts
+    const double open = mean_of(lamp_and_pane_scene(false, false, 64));
+    EXPECT_GT(open, 0.1);
+    EXPECT_EQ(mean_of(lamp_and_pane_scene(true, false, 4)), 0.0);
+    EXPECT_NEAR(mean_of(lamp_and_pane_scene(true, true, 32)) / open, 1, 0.03);
+}
+
 // Photons are traced only when the scene calls for them: a Falloff-1 light or an emitter, a
 // reflective or transparent surface, and a diffuse surface.
 TEST(PhotonMap, TracedOnlyWhenTheSceneCallsForThem) {
