@@ -471,6 +471,13 @@ class SceneReader {
         in.check(falloff == 0 || falloff == 1, "Falloff", "0 or 1");
         in.warn_unknown();
         warn_children(e);
+        if (visible && radius == 0)
+            context_.warn(e, "a point light (Radius 0) cannot be visible; Visible ignored");
+        if (falloff == 1 && radius > 0 && !visible && e.Attribute("Visible")) {
+            context_.warn(e,
+                          "a Falloff 1 light of Radius > 0 is an emitting sphere, which every "
+                          "ray sees; Visible=\"0\" ignored");
+        }
         if (falloff == 1 && radius == 0) {
             scene_.inverse_square_lights.push_back({position, intensity});
         } else if (falloff == 1) {
@@ -486,8 +493,6 @@ class SceneReader {
             }
             emitting_lights_.push_back({position, radius, std::move(material)});
         } else if (radius == 0) {
-            if (visible)
-                context_.warn(e, "a point light (Radius 0) cannot be visible; Visible ignored");
             scene_.lights.push_back(std::make_unique<PointLight>(position, intensity));
         } else {
             scene_.lights.push_back(

@@ -757,6 +757,24 @@ TEST(SceneLoaderWarnings, VisiblePointLightIsWarnedAbout) {
     EXPECT_EQ(loaded.warnings[0],
               "t.xml:2: warning: a point light (Radius 0) cannot be visible; Visible ignored");
     EXPECT_TRUE(loaded.scene.lights.at(0)->is_point());
+    // A Falloff-1 point light cannot be seen either; a Falloff-1 sphere light cannot be hidden.
+    const LoadedScene physical_point =
+        load(in_scene(R"(<Light Px="0" Py="0" Pz="0" Falloff="1" Visible="1"/>)"));
+    EXPECT_EQ(physical_point.warnings,
+              std::vector<std::string>{
+                  "t.xml:2: warning: a point light (Radius 0) cannot be visible; Visible ignored"});
+    const LoadedScene hidden =
+        load(in_scene(R"(<Light Px="0" Py="0" Pz="0" Radius="1" Falloff="1" Visible="0"/>)"));
+    EXPECT_EQ(hidden.warnings,
+              std::vector<std::string>{"t.xml:2: warning: a Falloff 1 light of Radius > 0 is an "
+                                       "emitting sphere, which every ray sees; Visible=\"0\" "
+                                       "ignored"});
+    EXPECT_EQ(hidden.scene.objects.size(), 1u);  // seen all the same
+    for (const char* quiet : {R"(<Light Px="0" Py="0" Pz="0" Radius="1" Falloff="1"/>)",
+                              R"(<Light Px="0" Py="0" Pz="0" Radius="1" Falloff="1" Visible="1"/>)",
+                              R"(<Light Px="0" Py="0" Pz="0" Radius="1" Visible="0"/>)"}) {
+        EXPECT_TRUE(load(in_scene(quiet)).warnings.empty()) << quiet;
+    }
 }
 
 TEST(SceneLoaderWarnings, TextInsideAnElementIsIgnored) {
