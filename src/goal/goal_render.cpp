@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <condition_variable>
-#include <limits>
 #include <mutex>
 #include <numeric>
 #include <span>
@@ -499,7 +498,7 @@ class GoalRender {
                 if (round.kind != RoundKind::kPilot) out_.job = std::move(job);
             } else if (!job.complete()) {
                 out_.stopped = options_.stop.stop_requested();
-                if (full_rounds_ == 0) out_.job = std::move(job);
+                if (image_rounds_ == 0) out_.job = std::move(job);
             } else {
                 record(round, std::move(job));
                 next = plan_next(out_.rounds.back());
@@ -545,7 +544,7 @@ class GoalRender {
         std::stop_source stopper;
         const std::stop_callback relay(options_.stop, [&] { stopper.request_stop(); });
         std::optional<Alarm> alarm;
-        if (goal_.time_limit && leader_ && full_rounds_ > 0) {
+        if (goal_.time_limit && leader_ && image_rounds_ > 0) {
             alarm.emplace(goal_.start + std::chrono::duration_cast<Clock::duration>(
                                             std::chrono::duration<double>(*goal_.time_limit)),
                           stopper);
@@ -572,6 +571,7 @@ class GoalRender {
                        .seed = round.seed};
         if (round.kind == RoundKind::kTopUp) {
             done.top_up_share = double(round.listed.size()) / double(image_pixels());
+            // Paired: each pixel rendered twice, the second render for the estimate.
             done.estimate_cost = 1;
         }
         if (round.kind != RoundKind::kPilot) {
@@ -625,7 +625,7 @@ class GoalRender {
             count == last->spp && std::none_of(out_.rounds.begin(), out_.rounds.end(),
                                                [](const GoalRound& r) { return r.top_up(); });
         next.spot_check_seed =
-            first ? std::optional(round_seed(seed_, full_rounds_ + 1)) : std::nullopt;
+            first ? std::optional(round_seed(seed_, image_rounds_ + 1)) : std::nullopt;
         std::optional<TopUp> t =
             plan_top_up(out_.job.render.spread, combination_->pair_variance(count), count,
                         kSpareShare * *goal_.target_error, next.spot_check_seed);
@@ -675,8 +675,8 @@ class GoalRender {
         round.listed = top_up_ ? top_up_->rendered() : std::vector<std::uint32_t>{};
         if (options_.mpi) round.listed = options_.mpi->broadcast(std::move(round.listed));
         round.kind = round.listed.empty() ? RoundKind::kFull : RoundKind::kTopUp;
-        if (last.kind != RoundKind::kPilot) ++full_rounds_;
-        round.seed = out_.combined ? round_seed(seed_, full_rounds_) : seed_;
+        if (last.kind != RoundKind::kPilot) ++image_rounds_;
+        round.seed = out_.combined ? round_seed(seed_, image_rounds_) : seed_;
         return round;
     }
 
@@ -692,8 +692,9 @@ class GoalRender {
     const bool leader_;
     GoalResult out_;
     std::optional<Combination> combination_;  // the leader's, for a target error
-    std::size_t full_rounds_ = 0;             // done, top-ups counted: the next one's round_seed
-    std::optional<TopUp> top_up_;             // the round in hand's, when a top-up (leader)
+    // Rounds done but the pilots, top-ups included: the next one's round_seed.
+    std::size_t image_rounds_ = 0;
+    std::optional<TopUp> top_up_;  // the round in hand's, when a top-up (leader)
 };
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <span>
 #include <vector>
 
+#include "drt/sampling/cdf_pick.h"
 #include "drt/util/rng.h"
 
 namespace drt {
@@ -373,13 +374,8 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
         const std::uint32_t dimension = dim::bounce(depth, dim::kLightPick);
         for (int j = 0; j < rays; ++j) {
             Vec2 u = sampler_.get_2d_for_ray(s, dimension, j, rays);
-            const auto& cdf = plan_.light_pick_cdf;
-            const std::size_t k = std::min<std::size_t>(
-                std::upper_bound(cdf.begin(), cdf.end(), u.x) - cdf.begin(), cdf.size() - 1);
-            const double lo = k == 0 ? 0.0 : cdf[k - 1];
-            const double p = cdf[k] - lo;
-            u.x =
-                std::clamp((u.x - lo) / p, 0.0, std::nextafter(1.0, 0.0));  // reuse within the pick
+            const auto [k, p, rest] = pick_from_cdf(plan_.light_pick_cdf, u.x);
+            u.x = rest;
             if (k >= area_lights_.size()) {
                 const std::size_t emitter = plan_.area_emitters[k - area_lights_.size()];
                 sum += emitter_ray(emitter, u, point, origin, leaving, geometric, shading, time,

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "drt/render/integrator.h"
+#include "drt/sampling/cdf_pick.h"
 #include "drt/util/rng.h"
 
 namespace drt {
@@ -56,16 +57,16 @@ PathIntegrator::PathIntegrator(const Scene& scene, const RenderPlan& plan, const
         any_visible_light_ = any_visible_light_ || light->visible();
         if (!light->is_point()) area_lights_.push_back(light.get());
     }
-    emitter_rays_.assign(plan.emitters.size(), 0.0);
+    expected_emitter_rays_.assign(plan.emitters.size(), 0.0);
     for (std::size_t i = 0; i < plan.emitters.size(); ++i) {
-        emitter_rays_[i] = plan.emitter_rays[i];
+        expected_emitter_rays_[i] = plan.emitter_rays[i];
     }
     // Shared rays: each picks emitter k with probability P_k, so N rays sample it N·P_k times.
     const auto& cdf = plan.light_pick_cdf;
     for (std::size_t j = 0; plan.shared_rays > 0 && j < plan.area_emitters.size(); ++j) {
         const std::size_t k = area_lights_.size() + j;
         const double p = cdf[k] - (k == 0 ? 0.0 : cdf[k - 1]);
-        emitter_rays_[plan.area_emitters[j]] += plan.shared_rays * p;
+        expected_emitter_rays_[plan.area_emitters[j]] += plan.shared_rays * p;
     }
 }
 
@@ -118,7 +119,8 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
             if (after_diffuse && emitter && strategy_ == Strategy::kLightOnly) {
                 weight = 0;
             } else if (after_diffuse && emitter && strategy_ == Strategy::kMis) {
-                const double light = emitter_rays_[*emitter] * scene_.environment->pdf(ray.dir);
+                const double light =
+                    expected_emitter_rays_[*emitter] * scene_.environment->pdf(ray.dir);
                 weight = power_heuristic(scatter_density, light);
             }
             return result + throughput * scene_.environment->radiance(ray.dir) * weight;
@@ -138,7 +140,7 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
             } else if (emitter && strategy_ == Strategy::kLightOnly) {
                 weight = 0;
             } else if (emitter && strategy_ == Strategy::kMis) {
-                const double light = emitter_rays_[*emitter] *
+                const double light = expected_emitter_rays_[*emitter] *
                                      plan_.emitters.pdf(*emitter, from, surface.point,
                                                         surface.normal, hit->primitive, ray.time);
                 weight = power_heuristic(scatter_density, light);
@@ -263,10 +265,10 @@ Color PathIntegrator::emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point
     if (!reached) return {};
     const auto& [sample, cosine, point_light] = *reached;
     if (point_light) return sample.radiance * cosine;
-    const double weight =
-        strategy_ == Strategy::kMis
-            ? power_heuristic(emitter_rays_[emitter] * sample.pdf, diffuse_pick * cosine / kPi)
-            : 1.0;
+    const double weight = strategy_ == Strategy::kMis
+                              ? power_heuristic(expected_emitter_rays_[emitter] * sample.pdf,
+                                                diffuse_pick * cosine / kPi)
+                              : 1.0;
     return sample.radiance * (cosine * weight / (kPi * sample.pdf));
 }
 
@@ -301,14 +303,10 @@ Color PathIntegrator::next_event(const Vec3& point, const Vec3& geometric, const
         // Each ray picks a light or an emitter in proportion to power and is divided by the
         // pick's probability, as in the distributed integrator.
         const int rays = plan_.shared_rays;
-        const auto& cdf = plan_.light_pick_cdf;
         for (int j = 0; j < rays; ++j) {
             Vec2 u = sampler_.get_2d_for_ray(s, path_dim::at(depth, path_dim::kLightPick), j, rays);
-            const std::size_t k = std::min<std::size_t>(
-                std::upper_bound(cdf.begin(), cdf.end(), u.x) - cdf.begin(), cdf.size() - 1);
-            const double lo = k == 0 ? 0.0 : cdf[k - 1];
-            const double p = cdf[k] - lo;
-            u.x = std::clamp((u.x - lo) / p, 0.0, std::nextafter(1.0, 0.0));
+            const auto [k, p, rest] = pick_from_cdf(plan_.light_pick_cdf, u.x);
+            u.x = rest;
             if (k < area_lights_.size()) {
                 sum += light_ray(*area_lights_[k], u, point, origin, leaving, geometric, shading,
                                  time, counts) /

@@ -6,12 +6,16 @@
 
 #include "drt/accel/triangle_mesh.h"
 #include "drt/render/integrator.h"
+#include "drt/sampling/cdf_pick.h"
 #include "drt/scene/light.h"
 #include "drt/util/rng.h"
 
 namespace drt {
 
 namespace {
+
+// α of the radius rule: each pass keeps this share of the previous pass's photons' statistics.
+constexpr double kPhotonAlpha = 2.0 / 3.0;
 
 // Keeps the photons' random numbers apart from every camera sample's.
 constexpr std::uint64_t kPhotonStream = 0x70686f746f6eULL;
@@ -272,9 +276,7 @@ std::vector<Photon> PhotonMaps::trace(std::uint64_t seed, std::uint32_t pass) co
 
 bool PhotonMaps::trace_one(std::uint64_t key, Photon& out) const {
     const auto u = [key](std::uint32_t j) { return unit(key, j); };
-    const std::size_t k = std::min<std::size_t>(
-        std::upper_bound(source_cdf_.begin(), source_cdf_.end(), u(kSource)) - source_cdf_.begin(),
-        source_cdf_.size() - 1);
+    const std::size_t k = pick_from_cdf(source_cdf_, u(kSource)).index;
     const Source& source = sources_[k];
     const Emitters::Emitter& e = plan_.emitters[source.emitter];
     const double time = plan_.effects.motion_blur ? u(kTime) * plan_.shutter_end : 0.0;
@@ -303,12 +305,7 @@ bool PhotonMaps::trace_one(std::uint64_t key, Photon& out) const {
             break;
         }
         case Emitters::Kind::kTriangles: {
-            const auto& cdf = e.area_cdf;
-            const double x = u(kEmitA);
-            const std::size_t t = std::min<std::size_t>(
-                std::upper_bound(cdf.begin(), cdf.end(), x) - cdf.begin(), cdf.size() - 1);
-            const double lo = t == 0 ? 0.0 : cdf[t - 1];
-            const double v = std::clamp((x - lo) / (cdf[t] - lo), 0.0, std::nextafter(1.0, 0.0));
+            const auto [t, p, v] = pick_from_cdf(e.area_cdf, u(kEmitA));
             // The emitter's own triangles: for a part of a shared mesh, not the mesh's t-th.
             const Emitters::Emitter::Triangle& triangle = e.triangles[t];
             const auto& c = triangle.corners;

@@ -410,7 +410,7 @@ std::uint64_t RenderContext::tile_cost(const Tile& tile, const RenderRequest& re
             const int px = std::min(x + block / 2, tile.x1 - 1);
             const int py = std::min(y + block / 2, tile.y1 - 1);
             const PixelSample s{request.seed,
-                                static_cast<std::uint32_t>(py * scene_.settings.width + px), 0, 1};
+                                static_cast<std::uint32_t>(pixel_index(scene_, px, py)), 0, 1};
             integrator(request).sample_pixel(px, py, s, color, rays);
             ++probes;
         }
@@ -425,6 +425,9 @@ std::uint64_t RenderContext::tile_cost(const Tile& tile, const RenderRequest& re
 // The key of the second, independent pattern of a pixel rendered twice: a ray-tree path of its
 // own, which every sampler folds into every number it draws.
 constexpr std::uint64_t kSecondRenderPath = 0xca11b4a7e5eedULL;
+
+// The ray-tree path of an adaptive round's new pattern (adaptive_pixel), hashed with the round.
+constexpr std::uint64_t kAdaptiveRoundPath = 0xada9717eULL;
 
 bool RenderContext::calibrate(const RenderRequest& request, const Tile& tile,
                               std::span<const Pixel> pixels, std::span<const std::size_t> rendered,
@@ -442,7 +445,7 @@ bool RenderContext::calibrate(const RenderRequest& request, const Tile& tile,
     for (const std::size_t i : rendered) {
         const int x = tile.x0 + static_cast<int>(i % width);
         const int y = tile.y0 + static_cast<int>(i / width);
-        const auto pixel = static_cast<std::uint32_t>(y * scene_.settings.width + x);
+        const auto pixel = static_cast<std::uint32_t>(pixel_index(scene_, x, y));
         if (to_unit(hash_of(request.seed, pixel, kSecondRenderPath)) < odds[i]) picked.push_back(i);
     }
     // The second renders' rays stay out of the image's ray counts: they are the estimate's cost,
@@ -509,8 +512,8 @@ std::optional<RenderContext::Pixel> RenderContext::plain_pixel(const RenderReque
                                                                Scratch& scratch, RayCounts& rays,
                                                                const std::stop_token& stop) const {
     const auto spp = static_cast<std::uint32_t>(request.samples);
-    const PixelSample s{request.seed, static_cast<std::uint32_t>(y * scene_.settings.width + x), 0,
-                        spp, path};
+    const PixelSample s{request.seed, static_cast<std::uint32_t>(pixel_index(scene_, x, y)), 0, spp,
+                        path};
     scratch.colors.resize(spp);
     if (!sample(request, x, y, s, scratch.colors, rays, stop)) return std::nullopt;
     Color sum;
@@ -537,7 +540,7 @@ std::optional<RenderContext::Pixel> RenderContext::adaptive_pixel(
     const auto spp = static_cast<std::uint32_t>(request.samples);
     const AdaptiveSampling adaptive = *request.applied_adaptive();
     const auto min_spp = static_cast<std::uint32_t>(adaptive.min_samples);
-    const auto pixel = static_cast<std::uint32_t>(y * scene_.settings.width + x);
+    const auto pixel = static_cast<std::uint32_t>(pixel_index(scene_, x, y));
     const bool extensible = sampler_->extensible();
     std::vector<double>& luminances = scratch.luminances;
     Color sum;
@@ -549,7 +552,7 @@ std::optional<RenderContext::Pixel> RenderContext::adaptive_pixel(
         const std::uint32_t batch = std::min(round == 0 ? min_spp : n, spp - n);
         PixelSample s{request.seed, pixel, 0, extensible ? spp : batch, path};
         if (!extensible && round > 0) {
-            s.path = path == 0 ? hash_of(0xada9717eULL, round) : hash_of(path, round);
+            s.path = path == 0 ? hash_of(kAdaptiveRoundPath, round) : hash_of(path, round);
         }
         s.index = extensible ? n : 0;
         s.pass_base = extensible ? 0 : n;

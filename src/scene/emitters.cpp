@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "drt/geometry/sphere.h"
+#include "drt/sampling/cdf_pick.h"
 #include "drt/sampling/spherical_triangle.h"
 #include "drt/scene/light.h"
 
@@ -168,16 +169,7 @@ std::optional<EmitterSample> Emitters::sample(std::size_t i, const Vec3& x, Vec2
                                  1 / (2 * kPi * one_minus_cos_max(d2, e.radius))};
         }
         case Kind::kTriangles: {
-            const auto& cdf = e.area_cdf;
-            // One triangle (a <Triangle>) needs no search: u.x is then the triangle's own.
-            const std::size_t k =
-                cdf.size() == 1 ? 0
-                                : std::min<std::size_t>(
-                                      std::upper_bound(cdf.begin(), cdf.end(), u.x) - cdf.begin(),
-                                      cdf.size() - 1);
-            const double lo = k == 0 ? 0.0 : cdf[k - 1];
-            // The pick's share of u.x, stretched back over [0, 1): a well-spread u stays so.
-            const double v = std::clamp((u.x - lo) / (cdf[k] - lo), 0.0, std::nextafter(1.0, 0.0));
+            const auto [k, pick, v] = pick_from_cdf(e.area_cdf, u.x);
             const Emitter::Triangle& t = e.triangles[k];
             const Vec3 origin = e.path->at(time);
             if (const auto spherical = by_solid_angle(t, x - origin)) {

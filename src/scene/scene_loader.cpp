@@ -32,8 +32,6 @@
 #include "drt/scene/surface_spec.h"
 #include "drt/scene/texture_cache.h"
 #include "drt/scene/xml_attributes.h"
-#include "drt/shading/image_texture.h"
-#include "drt/shading/texture.h"
 #include "drt/util/file_reader.h"
 #include "drt/util/limits.h"
 #include "drt/util/text.h"
@@ -605,8 +603,8 @@ class SceneReader {
 
     // The mesh of the <Triangle> groups, one part each (when there are several). A triangle that
     // single precision cannot hold about the mesh's origin (a small one far from the others) is
-    // an object of its own, as it was before triangles were grouped: it is dropped with a
-    // warning only if it cannot be held even so.
+    // an object of its own, with its own origin: it is dropped with a warning only if it cannot
+    // be held even so.
     void build_triangle_groups() {
         if (triangle_groups_.empty()) return;
         const auto mesh_of = [this](const XMLElement& e, std::span<const std::array<Vec3, 3>> t,

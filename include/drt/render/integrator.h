@@ -80,7 +80,7 @@ SurfaceHit surface_of(const Ray& ray, const Hit& hit, int depth, const Camera& c
 // survives Russian roulette by its throughput (both divided by their odds: unbiased). Glass
 // between mirrors doubles the tree at each bounce, 2^MaxDepth rays a sample, which no render
 // could trace at MaxDepth 512; the trees of the repository's scenes stay below the bound, so
-// they render as they did before it.
+// none of them reaches the roulette.
 inline constexpr std::uint64_t kWholeTreeRays = 4096;
 
 class Integrator final : public PixelIntegrator {
@@ -112,7 +112,8 @@ class Integrator final : public PixelIntegrator {
     Color radiance(const Ray& ray, const PixelSample& s, int depth, PixelWork& work,
                    Leaving leaving = {}, double throughput = 1) const;
     // Σ lights at a point: I · max(0, N·ω) · visibility, averaged over each light's shadow rays,
-    // which skip the triangle `leaving`.
+    // and the emitters' and emitting planes' light in the same units; every ray skips the
+    // triangle `leaving`.
     Color direct_light(const Vec3& point, const Vec3& geometric, const Vec3& shading,
                        Leaving leaving, double time, const PixelSample& s, int depth,
                        RayCounts& counts) const;

@@ -71,7 +71,7 @@ class PathIntegrator final : public PixelIntegrator {
     std::vector<const Light*> area_lights_;  // in scene order, as plan_.light_pick_cdf
     // For each emitter, the expected number of its shadow rays per diffuse event: what the
     // density of its light samples is multiplied by when weighed against the scattered ray.
-    std::vector<double> emitter_rays_;
+    std::vector<double> expected_emitter_rays_;
     bool any_visible_light_ = false;
 };
 

@@ -27,9 +27,6 @@
 
 namespace drt {
 
-// α of the radius rule: each pass keeps this share of the previous pass's photons' statistics.
-inline constexpr double kPhotonAlpha = 2.0 / 3.0;
-
 // r_k² / r_1² for pass k (0-based): Π_{j=1..k} (j + α)/(j + 1), about k^(α−1) for large k.
 double photon_radius2_factor(std::uint32_t pass);
 
@@ -50,7 +47,6 @@ class PhotonPass {
     // Caustic light at `point` of a surface whose normal `normal` faces the viewer: the photons
     // within the radius that arrived on that side and lie near its tangent plane.
     Color estimate(const Vec3& point, const Vec3& normal) const;
-    std::size_t size() const { return photons_.size(); }
     double radius() const { return radius_; }
 
   private:
@@ -75,8 +71,6 @@ class PhotonMaps {
     std::shared_ptr<const PhotonPass> pass(std::uint64_t seed, std::uint32_t pass) const;
     // Photons traced so far, over every pass built.
     std::uint64_t traced() const { return traced_.load(); }
-    double first_radius() const { return radius_; }
-    int count() const { return count_; }
 
     // The photons of pass `pass` as stored, in photon order (before any grid).
     std::vector<Photon> trace(std::uint64_t seed, std::uint32_t pass) const;

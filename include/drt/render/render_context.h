@@ -110,12 +110,12 @@ class RenderContext {
     // taker will open another, or until `stop` is requested; returns how many it rendered.
     std::size_t help(Workbench& bench, const std::stop_token& stop) const;
 
-    // A guess at what render_tile(tile, request) costs, in shaded rays (camera, reflection and
-    // refraction rays: shadow rays left out, cheap beside the shading they serve): those one camera
-    // sample traces at a probe pixel in each 4 × 4 block of the tile (8 × 8 under 16 samples per
-    // pixel), scaled to the tile's pixels. Ray counts, not clock time, so the guess is the same
-    // on every machine and in every run; the probes cost 1/16 of one sample per pixel and change
-    // no pixel.
+    // A guess at what render_tile(tile, request) costs, in shaded rays (camera, reflection,
+    // refraction and diffuse rays: shadow rays left out, cheap beside the shading they serve):
+    // those one camera sample traces at a probe pixel in each 4 × 4 block of the tile (8 × 8
+    // under 16 samples per pixel), scaled to the tile's pixels. Ray counts, not clock time, so
+    // the guess is the same on every machine and in every run; the probes cost 1/16 of one
+    // sample per pixel and change no pixel.
     std::uint64_t tile_cost(const Tile& tile, const RenderRequest& request) const;
 
   private:

@@ -36,7 +36,7 @@ class Emitters {
     enum class Kind { kPoint, kSphere, kTriangles, kEnvironment };
     struct Emitter {
         Kind kind = Kind::kPoint;
-        Color radiance;                    // a point's intensity I
+        Color radiance;                    // a surface's radiance; a point's intensity I
         const Object* object = nullptr;    // the emitting object; null for a point
         Vec3 position;                     // a point's
         const MotionPath* path = nullptr;  // a sphere's centre, a mesh's origin, over time
