@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "drt/render/integrator.h"
+#include "drt/render/scattering.h"
 
 namespace drt {
 

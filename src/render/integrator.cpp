@@ -13,53 +13,11 @@ namespace drt {
 
 namespace {
 
-// Attempts at drawing a perturbed direction on the right side of a surface before falling back
-// to the ideal one; at grazing incidence about half the draws land on the wrong side, so the
-// fallback is taken with probability about 2^-32.
-constexpr int kRedrawAttempts = 32;
-
 // The point of the unit square that Light::sample maps to the light's centre as seen from outside
 // (cos θ = 1 in the cone): a light whose area is not sampled acts as a point there.
 constexpr Vec2 kLightCentre{0, 0};
 
 }  // namespace
-
-// A camera ray's footprint is 1/√samples of a pixel across, as pbrt-v4 scales its
-// differentials, but at least an eighth.
-SurfaceHit surface_of(const Ray& ray, const Hit& hit, int depth, const Camera& camera,
-                      int samples) {
-    if (depth > 0 || !hit.object->reads_uv()) return hit.object->surface_at(ray, hit);
-    const double step = std::max(0.125, 1 / std::sqrt(std::max(samples, 1)));
-    const RayDifferential differential = camera.differential(ray, step);
-    return hit.object->surface_at(ray, hit, &differential);
-}
-
-Vec3 reflect_above(const Vec3& d, const Vec3& shading, const Vec3& geometric) {
-    const Vec3 r = reflect(d, shading);
-    return dot(r, geometric) > 0 ? r : reflect(d, geometric);
-}
-
-std::optional<Vec3> refract_below(const Vec3& d, const Vec3& shading, const Vec3& geometric,
-                                  double eta) {
-    const auto through = refract(d, shading, eta);
-    if (through && dot(*through, geometric) < 0) return through;
-    return refract(d, geometric, eta);
-}
-
-Ray spawn_ray(const Vec3& point, const Vec3& normal, const Vec3& dir, double time) {
-    const double offset = max_abs_component(point) * 0x1.0p-32 + 1e-9;
-    const Vec3 towards = dot(dir, normal) >= 0 ? normal : -normal;
-    return {point + towards * offset, dir, time};
-}
-
-Vec3 perturb_direction(const Vec3& ideal, double sigma, Vec2 u) {
-    // Box-Muller radius: the length of a 2-D normal vector with per-axis deviation sigma.
-    const double theta = sigma * std::sqrt(-2.0 * std::log1p(-u.x));
-    const SinCos phi = sincos_turns(u.y);
-    const double sin_t = std::sin(theta);
-    const Vec3 local{sin_t * phi.cos, sin_t * phi.sin, std::cos(theta)};
-    return normalize(Frame::around(ideal).to_world(local));
-}
 
 Integrator::Integrator(const Scene& scene, const RenderPlan& plan, const Bvh& bvh,
                        const Sampler& sampler, const PhotonMaps* photons,
@@ -239,19 +197,14 @@ Color Integrator::scattered(const Facing& at, Leaving leaving, const Scatter& ho
         }
         Vec3 dir = how.ideal;
         if (how.sigma > 0) {
-            Vec2 u = rays == 1 ? work.points.get_2d(s, dimension)
-                               : sampler_.get_2d_in_set(s, dimension, j, rays);
-            for (int attempt = 1;; ++attempt) {
-                dir = perturb_direction(how.ideal, how.sigma, u);
-                if (how.side * dot(dir, at.geometric) > 0) break;
-                if (attempt == kRedrawAttempts) {
-                    dir = how.ideal;
-                    break;
-                }
-                const std::uint64_t h =
-                    hash_of(s.seed, s.pixel, s.index, dimension, s.path, j, attempt);
-                u = {to_unit(h), to_unit(mix64(h))};
-            }
+            const Vec2 u = rays == 1 ? work.points.get_2d(s, dimension)
+                                     : sampler_.get_2d_in_set(s, dimension, j, rays);
+            dir =
+                perturb_on_side(how.ideal, how.sigma, how.side, at.geometric, u, [&](int attempt) {
+                    const std::uint64_t h =
+                        hash_of(s.seed, s.pixel, s.index, dimension, s.path, j, attempt);
+                    return Vec2{to_unit(h), to_unit(mix64(h))};
+                });
         }
         ++(how.refraction ? work.counts.refraction : work.counts.reflection);
         ++work.tree_rays;
@@ -271,23 +224,6 @@ Color Integrator::light_ray(const Light& light, const LightSample& ls, const Vec
     ++counts.shadow;
     if (occluders.occluded(bvh_, {origin, ls.dir, time}, {0, ls.distance}, leaving)) return {};
     return light.intensity() * cosine;
-}
-
-std::optional<ReachingEmitter> reach_emitter(const Emitters& emitters, const Bvh& bvh,
-                                             std::size_t emitter, Vec2 u, const Vec3& point,
-                                             const Vec3& origin, Leaving leaving,
-                                             const Vec3& geometric, const Vec3& shading,
-                                             double time, RayCounts& counts) {
-    const auto sample = emitters.sample(emitter, point, u, time);
-    if (!sample) return std::nullopt;
-    const double cosine = lit_cosine(sample->dir, shading, geometric);
-    if (cosine == 0) return std::nullopt;
-    ++counts.shadow;
-    const bool point_light = emitters.is_point(emitter);
-    // An emitting surface is in the BVH: the ray stops just short of it.
-    const double reach = point_light ? sample->distance : sample->distance * kShortOfEmitter;
-    if (bvh.occluded({origin, sample->dir, time}, {0, reach}, leaving)) return std::nullopt;
-    return ReachingEmitter{*sample, cosine, point_light};
 }
 
 Color Integrator::emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point, const Vec3& origin,

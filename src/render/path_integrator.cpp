@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "drt/render/integrator.h"
+#include "drt/render/scattering.h"
 #include "drt/sampling/cdf_pick.h"
 #include "drt/util/rng.h"
 
@@ -24,14 +24,6 @@ constexpr std::uint32_t light(int depth, std::size_t index) {
     return at(depth, kLight) + (static_cast<std::uint32_t>(index) << 16);
 }
 }  // namespace path_dim
-
-// Scattering events before Russian roulette may end a path: the first bounces carry most of the
-// light and are never cut short.
-constexpr int kRouletteStart = 3;
-
-// As in the distributed integrator: a perturbed direction on the wrong side is redrawn this often
-// before the ideal one is taken.
-constexpr int kRedrawAttempts = 32;
 
 // Veach's power heuristic (exponent 2) for a sample of density `own` against one of `other`,
 // both already multiplied by their expected sample counts; written as a ratio so that a huge
@@ -235,14 +227,12 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
 Vec3 PathIntegrator::perturbed(const Vec3& ideal, double sigma, double side, const Vec3& geometric,
                                const PixelSample& s, std::uint32_t dimension) const {
     if (!(sigma > 0)) return ideal;
-    Vec2 u = sampler_.get_2d(s, dimension);
-    for (int attempt = 1;; ++attempt) {
-        const Vec3 dir = perturb_direction(ideal, sigma, u);
-        if (side * dot(dir, geometric) > 0) return dir;
-        if (attempt == kRedrawAttempts) return ideal;
-        const std::uint64_t h = hash_of(s.seed, s.pixel, s.index, dimension, s.path, 0, attempt);
-        u = {to_unit(h), to_unit(mix64(h))};
-    }
+    return perturb_on_side(ideal, sigma, side, geometric, sampler_.get_2d(s, dimension),
+                           [&](int attempt) {
+                               const std::uint64_t h =
+                                   hash_of(s.seed, s.pixel, s.index, dimension, s.path, 0, attempt);
+                               return Vec2{to_unit(h), to_unit(mix64(h))};
+                           });
 }
 
 Color PathIntegrator::light_ray(const Light& light, Vec2 u, const Vec3& point, const Vec3& origin,

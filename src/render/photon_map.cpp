@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "drt/accel/triangle_mesh.h"
-#include "drt/render/integrator.h"
+#include "drt/render/scattering.h"
 #include "drt/sampling/cdf_pick.h"
 #include "drt/scene/light.h"
 #include "drt/util/rng.h"
@@ -24,10 +24,6 @@ constexpr std::uint64_t kPhotonStream = 0x70686f746f6eULL;
 enum : std::uint32_t { kSource, kTime, kEmitA, kEmitB, kEmitC, kEmitD, kSide, kFirstEvent = 8 };
 enum : std::uint32_t { kLobe, kFresnel, kRoulette, kScatter, kPerEvent = 8 };
 
-// Events before Russian roulette may end a photon, as in the path integrator.
-constexpr int kRouletteStart = 3;
-constexpr int kRedrawAttempts = 32;
-
 // A photon counts for a gather point only within this share of the radius of its tangent plane:
 // the disc a density estimate assumes, which keeps light from leaking round corners.
 constexpr double kSlab = 0.5;
@@ -40,12 +36,11 @@ double unit(std::uint64_t key, std::uint32_t j) {
 Vec3 perturbed(const Vec3& ideal, double sigma, double side, const Vec3& geometric,
                std::uint64_t key, std::uint32_t dimension) {
     if (!(sigma > 0)) return ideal;
-    for (int attempt = 0; attempt < kRedrawAttempts; ++attempt) {
+    const auto draw = [&](int attempt) {
         const std::uint64_t h = hash_combine(key, (std::uint64_t{dimension} << 8) | attempt);
-        const Vec3 dir = perturb_direction(ideal, sigma, {to_unit(h), to_unit(mix64(h))});
-        if (side * dot(dir, geometric) > 0) return dir;
-    }
-    return ideal;
+        return Vec2{to_unit(h), to_unit(mix64(h))};
+    };
+    return perturb_on_side(ideal, sigma, side, geometric, draw(0), draw);
 }
 
 std::int64_t cell_of(double x, double cell) {

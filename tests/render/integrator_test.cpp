@@ -288,29 +288,6 @@ TEST(Integrator, ImageIsIdenticalForOneAndTwoThreads) {
     EXPECT_NE(render_with(scene, 2).image.rgb, one.image.rgb);
 }
 
-TEST(SpawnRay, LeavesTheSurfaceOnTheSideOfTheDirection) {
-    const Vec3 p{1e5, 0, -1e5};
-    const Ray up = spawn_ray(p, {0, 1, 0}, normalize(Vec3{1, 1e-3, 0}), 0);
-    EXPECT_GT(up.origin.y, 0);
-    const Ray down = spawn_ray(p, {0, 1, 0}, normalize(Vec3{1, -1e-3, 0}), 0);
-    EXPECT_LT(down.origin.y, 0);
-}
-
-TEST(PerturbDirection, AngularSpreadMatchesSigma) {
-    const Vec3 ideal = normalize(Vec3{0.3, 1, -0.2});
-    const double sigma = 0.05;
-    double sum_sq = 0;
-    const int n = 64 * 64;
-    for (int i = 0; i < n; ++i) {
-        const Vec2 u = multi_jittered(i, n, 99);
-        const double angle =
-            std::acos(std::min(1.0, dot(perturb_direction(ideal, sigma, u), ideal)));
-        sum_sq += angle * angle;
-    }
-    // The angle of a 2-D normal offset with per-axis deviation sigma has E[angle^2] = 2 sigma^2.
-    EXPECT_NEAR(sum_sq / n, 2 * sigma * sigma, 0.02 * 2 * sigma * sigma);
-}
-
 // Integrator runs with a plan whose effect flags may be changed from what plan_render decides.
 class PlannedIntegrator {
   public:
