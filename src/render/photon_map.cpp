@@ -202,8 +202,7 @@ Cone cone_towards(const Ball& ball, const Vec3& from) {
     const double d2 = dot(to, to);
     const double r2 = ball.radius * ball.radius;
     if (d2 <= r2 * (1 + 1e-9)) return {{0, 0, 1}, -1, 4 * kPi};
-    const double sin2 = r2 / d2;
-    const double one_minus_cos = sin2 / (1 + std::sqrt(1 - sin2));
+    const double one_minus_cos = sphere_cone_one_minus_cos(d2, ball.radius);
     return {to / std::sqrt(d2), 1 - one_minus_cos, 2 * kPi * one_minus_cos};
 }
 

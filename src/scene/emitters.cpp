@@ -20,13 +20,6 @@ bool inside_sphere(double d2, double radius) {
     return d2 <= radius * radius * (1 + kOnSphere);
 }
 
-// 1 − cos of the half-angle of the cone a sphere subtends from a point d² away from its centre,
-// without the cancellation of 1 − sqrt(1 − r²/d²) for a small, distant sphere.
-double one_minus_cos_max(double d2, double radius) {
-    const double sin2 = radius * radius / d2;
-    return sin2 / (1 + std::sqrt(std::max(0.0, 1 - sin2)));
-}
-
 double triangle_area(const std::array<Vec3, 3>& p) {
     return 0.5 * length(cross(p[1] - p[0], p[2] - p[0]));
 }
@@ -166,7 +159,7 @@ std::optional<EmitterSample> Emitters::sample(std::size_t i, const Vec3& x, Vec2
             const double distance =
                 d * c.cos_t - std::sqrt(positive_part(e.radius * e.radius - d2 * c.sin2_t));
             return EmitterSample{dir, distance, e.radiance,
-                                 1 / (2 * kPi * one_minus_cos_max(d2, e.radius))};
+                                 1 / (2 * kPi * sphere_cone_one_minus_cos(d2, e.radius))};
         }
         case Kind::kTriangles: {
             const auto [k, pick, v] = pick_from_cdf(e.area_cdf, u.x);
@@ -213,7 +206,7 @@ double Emitters::pdf(std::size_t i, const Vec3& x, const Vec3& point, const Vec3
             const Vec3 to_centre = e.path->at(time) - x;
             const double d2 = dot(to_centre, to_centre);
             if (inside_sphere(d2, e.radius)) return 1 / (4 * kPi);
-            return 1 / (2 * kPi * one_minus_cos_max(d2, e.radius));
+            return 1 / (2 * kPi * sphere_cone_one_minus_cos(d2, e.radius));
         }
         case Kind::kTriangles: {
             if (!e.index_of_triangle.empty()) {

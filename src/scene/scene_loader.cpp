@@ -349,16 +349,12 @@ class SceneReader {
         const double intensity = in.number("Intensity", 1);
         in.check(intensity >= 0, "Intensity", "non-negative");
         const double rotate_y = in.number("RotateY", 0) * (kPi / 180);
-        const std::filesystem::path path =
-            std::filesystem::path(context_.file()).parent_path() / file;
-        const std::size_t before = textures_.files_read();
         std::shared_ptr<const MipMap> image;
         try {
-            image = textures_.get(path, TextureEncoding::kColor);
+            image = cached_image(beside_scene(file), TextureEncoding::kColor);
         } catch (const ImageError& error) {
             in.fail(error.what());
         }
-        if (textures_.files_read() > before) files_read_.push_back(path);
         scene_.environment =
             std::make_shared<const Environment>(std::move(image), intensity, rotate_y);
         in.warn_unknown();
@@ -679,8 +675,7 @@ class SceneReader {
         read_motion(e, "Tx", "Ty", "Tz", path);
 
         // Relative to the scene file's folder, as the scene's author sees it.
-        const std::filesystem::path obj_path =
-            std::filesystem::path(context_.file()).parent_path() / file;
+        const std::filesystem::path obj_path = beside_scene(file);
         ObjMesh obj;
         try {
             obj = read_obj(obj_path);
@@ -697,14 +692,7 @@ class SceneReader {
         keep_texcoords_if(reads_uv(surface), obj);
         obj.triangle_materials.clear();  // one material for all: the file's make no parts
         auto mesh = build_mesh(in, std::move(obj), transform, smooth);
-        if (const std::size_t n = mesh->dropped(); n > 0) {
-            context_.warn(e, std::to_string(n) + (n == 1 ? " triangle" : " triangles") +
-                                 " of zero area in " + obj_path.string() + " dropped");
-        }
-        if (const std::size_t n = mesh->collapsed(); n > 0) {
-            context_.warn(e, std::to_string(n) + (n == 1 ? " triangle" : " triangles") + " in " +
-                                 obj_path.string() + " too thin for single precision dropped");
-        }
+        warn_dropped(e, obj_path, mesh->dropped(), mesh->collapsed());
         pending_.push_back(
             {&e, std::string(*material), std::move(surface),
              [mesh = std::move(mesh), path = std::move(path)](const Material& m, SurfaceDetail d) {
@@ -775,14 +763,23 @@ class SceneReader {
                              "faces without a material from the file's mtllib are grey "
                              "(diffuse 1, kd 0.8)");
         }
-        if (dropped > 0) {
-            context_.warn(e, std::to_string(dropped) + (dropped == 1 ? " triangle" : " triangles") +
-                                 " of zero area in " + obj_path.string() + " dropped");
+        warn_dropped(e, obj_path, dropped, collapsed);
+    }
+
+    // The triangles of an OBJ file a mesh could not keep: of zero area, or too thin for the
+    // mesh's single-precision corners.
+    void warn_dropped(const XMLElement& e, const std::filesystem::path& obj_path,
+                      std::size_t zero_area, std::size_t too_thin) {
+        const auto triangles = [](std::size_t n) {
+            return std::to_string(n) + (n == 1 ? " triangle" : " triangles");
+        };
+        if (zero_area > 0) {
+            context_.warn(
+                e, triangles(zero_area) + " of zero area in " + obj_path.string() + " dropped");
         }
-        if (collapsed > 0) {
-            context_.warn(e, std::to_string(collapsed) +
-                                 (collapsed == 1 ? " triangle" : " triangles") + " in " +
-                                 obj_path.string() + " too thin for single precision dropped");
+        if (too_thin > 0) {
+            context_.warn(e, triangles(too_thin) + " in " + obj_path.string() +
+                                 " too thin for single precision dropped");
         }
     }
 
@@ -866,11 +863,8 @@ class SceneReader {
         const std::filesystem::path file = m.mtl_path.parent_path() / image->path;
         std::error_code error;
         if (!std::filesystem::is_regular_file(file, error)) return nullptr;  // warned already
-        const std::size_t before = textures_.files_read();
         try {
-            auto mipmap = textures_.get(file, encoding);
-            if (textures_.files_read() > before) files_read_.push_back(file);
-            return mipmap;
+            return cached_image(file, encoding);
         } catch (const ImageError& e) {
             context_.warn_in(m.mtl_path.string(), image->line,
                              std::string(e.what()) + "; " + without(&image, m.mtl));
@@ -891,16 +885,26 @@ class SceneReader {
         }
     }
 
+    // A file the scene names, relative to the scene file's folder.
+    std::filesystem::path beside_scene(const std::string& file) const {
+        return std::filesystem::path(context_.file()).parent_path() / file;
+    }
+
+    // An image through the scene's cache; a file read for the first time joins the files the
+    // checkpoint's fingerprint covers. Throws ImageError.
+    std::shared_ptr<const MipMap> cached_image(const std::filesystem::path& file,
+                                               TextureEncoding encoding) {
+        const std::size_t before = textures_.files_read();
+        auto image = textures_.get(file, encoding);
+        if (textures_.files_read() > before) files_read_.push_back(file);
+        return image;
+    }
+
     // The images a surface names, relative to the scene file's folder, through the scene's cache.
     void load_images(const Attributes& in, SurfaceSpec& surface) {
         const auto load = [&](const std::string& file, TextureEncoding encoding) {
-            const std::filesystem::path path =
-                std::filesystem::path(context_.file()).parent_path() / file;
-            const std::size_t before = textures_.files_read();
             try {
-                auto image = textures_.get(path, encoding);
-                if (textures_.files_read() > before) files_read_.push_back(path);
-                return image;
+                return cached_image(beside_scene(file), encoding);
             } catch (const ImageError& error) {
                 in.fail(error.what());
             }

@@ -117,4 +117,11 @@ inline Vec3 sample_cone(Vec2 u, double cos_max) {
     return {c.x, c.y, c.cos_t};
 }
 
+// 1 − cos of the half-angle of the cone a sphere subtends from a point d² away from its centre
+// (outside it), without the cancellation of 1 − sqrt(1 − r²/d²) for a small, distant sphere.
+inline double sphere_cone_one_minus_cos(double d2, double radius) {
+    const double sin2 = radius * radius / d2;
+    return sin2 / (1 + std::sqrt(positive_part(1 - sin2)));
+}
+
 }  // namespace drt
