@@ -55,9 +55,8 @@ std::unique_ptr<Sampler> sampler_named(const std::string& name) {
     return sampler;
 }
 
-// The scene's plan with pixel-area sampling on or off.
-RenderPlan plan_with(const Scene& scene, bool antialiasing) {
-    RenderPlan plan = plan_render(scene);
+// `plan` with pixel-area sampling on or off (a copy shares the plan's emitters).
+RenderPlan plan_with(RenderPlan plan, bool antialiasing) {
     plan.effects.antialiasing = antialiasing;
     return plan;
 }
@@ -83,8 +82,8 @@ RenderContext::RenderContext(const Scene& scene)
     : scene_(scene),
       sampler_(sampler_named(scene.settings.sampler)),
       bvh_(scene.objects),
-      area_plan_(plan_with(scene, true)),
-      centre_plan_(plan_with(scene, false)),
+      area_plan_(plan_with(plan_render(scene), true)),
+      centre_plan_(plan_with(area_plan_, false)),
       photons_(area_plan_.effects.caustics
                    ? std::make_unique<const PhotonMaps>(scene, area_plan_, bvh_)
                    : nullptr),

@@ -53,13 +53,14 @@ std::optional<SphericalTriangle> by_solid_angle(const Emitters::Emitter::Triangl
 }  // namespace
 
 Emitters::Emitters(const Scene& scene) {
+    auto data = std::make_shared<Data>();
     for (const InverseSquareLight& light : scene.inverse_square_lights) {
         Emitter e;
         e.kind = Kind::kPoint;
         e.radiance = light.intensity;
         e.position = light.position;
         e.power = std::max(0.0, luminance(light.intensity));
-        emitters_.push_back(std::move(e));
+        data->emitters.push_back(std::move(e));
     }
     for (const auto& object : scene.objects) {
         const Material& m = object->material();
@@ -73,7 +74,7 @@ Emitters::Emitters(const Scene& scene) {
             e.path = sphere.path;
             e.radius = sphere.radius;
             e.area = 4 * kPi * sphere.radius * sphere.radius;
-            emitters_.push_back(std::move(e));
+            data->emitters.push_back(std::move(e));
         }
         for (const MeshShape& shape : shapes.meshes) {
             Emitter e;
@@ -106,14 +107,14 @@ Emitters::Emitters(const Scene& scene) {
             for (double& c : e.area_cdf) c /= e.area;
             e.area_cdf.back() = 1.0;
             for (Emitter::Triangle& t : e.triangles) t.pick /= e.area;
-            emitters_.push_back(std::move(e));
+            data->emitters.push_back(std::move(e));
         }
     }
-    for (std::size_t i = 0; i < emitters_.size(); ++i) {
-        Emitter& e = emitters_[i];
+    for (std::size_t i = 0; i < data->emitters.size(); ++i) {
+        Emitter& e = data->emitters[i];
         if (e.kind != Kind::kPoint) {
             e.power = std::max(0.0, luminance(e.radiance)) * e.area / (4 * kPi);
-            by_object_.emplace(e.object, i);
+            data->by_object.emplace(e.object, i);
         }
     }
     if (scene.environment) {
@@ -121,19 +122,20 @@ Emitters::Emitters(const Scene& scene) {
         e.kind = Kind::kEnvironment;
         e.environment = scene.environment.get();
         e.power = std::max(0.0, scene.environment->power());
-        emitters_.push_back(std::move(e));
+        data->emitters.push_back(std::move(e));
     }
+    data_ = std::move(data);
 }
 
 std::optional<std::size_t> Emitters::index_of(const Object* object) const {
-    const auto it = by_object_.find(object);
-    if (it == by_object_.end()) return std::nullopt;
+    const auto it = data_->by_object.find(object);
+    if (it == data_->by_object.end()) return std::nullopt;
     return it->second;
 }
 
 std::optional<EmitterSample> Emitters::sample(std::size_t i, const Vec3& x, Vec2 u,
                                               double time) const {
-    const Emitter& e = emitters_[i];
+    const Emitter& e = data_->emitters[i];
     switch (e.kind) {
         case Kind::kPoint: {
             const Vec3 v = e.position - x;
@@ -198,7 +200,7 @@ std::optional<EmitterSample> Emitters::sample(std::size_t i, const Vec3& x, Vec2
 
 double Emitters::pdf(std::size_t i, const Vec3& x, const Vec3& point, const Vec3& normal,
                      std::uint32_t primitive, double time) const {
-    const Emitter& e = emitters_[i];
+    const Emitter& e = data_->emitters[i];
     switch (e.kind) {
         case Kind::kPoint:
             return 0;

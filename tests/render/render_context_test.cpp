@@ -240,6 +240,23 @@ TEST(RenderContext, AStopIsHeardWithinAPixel) {
     }
 }
 
+// A request of one sample a pixel and one of more have plans of their own (pixel centres or
+// areas), which share one copy of the emitters: an emitting mesh's per-triangle data is kept once.
+TEST(RenderContext, ThePlansForCentresAndAreasShareTheirEmitters) {
+    const Scene scene = testing::scaled_scene("gi/cornell-box.xml", 8, 4);
+    const RenderContext context(scene);
+    RenderRequest areas = RenderRequest::whole_image(scene.settings);
+    RenderRequest centres = areas;
+    centres.samples = 1;
+    const Emitters& a = context.plan(areas).emitters;
+    const Emitters& c = context.plan(centres).emitters;
+    ASSERT_EQ(a.size(), 1u);  // the lamp
+    EXPECT_TRUE(context.plan(areas).effects.antialiasing);
+    EXPECT_FALSE(context.plan(centres).effects.antialiasing);
+    EXPECT_EQ(&a[0], &c[0]);
+    EXPECT_EQ(a[0].triangles.size(), 2u);
+}
+
 // One pixel in block x block of `scene`'s image.
 RenderRequest one_per_block(const Scene& scene, int block) {
     RenderRequest request = RenderRequest::whole_image(scene.settings);

@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <unordered_map>
 #include <vector>
@@ -69,9 +70,9 @@ class Emitters {
     Emitters() = default;
     explicit Emitters(const Scene& scene);
 
-    std::size_t size() const { return emitters_.size(); }
-    const Emitter& operator[](std::size_t i) const { return emitters_[i]; }
-    bool is_point(std::size_t i) const { return emitters_[i].kind == Kind::kPoint; }
+    std::size_t size() const { return data_->emitters.size(); }
+    const Emitter& operator[](std::size_t i) const { return data_->emitters[i]; }
+    bool is_point(std::size_t i) const { return data_->emitters[i].kind == Kind::kPoint; }
 
     // A direction towards emitter i from x at `time`, from a uniform point u of the unit square;
     // nothing when the sample cannot reach x (an edge-on triangle).
@@ -85,13 +86,19 @@ class Emitters {
     std::optional<std::size_t> index_of(const Object* object) const;
     // Which emitter the environment is, if there is one.
     std::optional<std::size_t> environment_index() const {
-        if (emitters_.empty() || emitters_.back().kind != Kind::kEnvironment) return std::nullopt;
-        return emitters_.size() - 1;
+        const std::vector<Emitter>& all = data_->emitters;
+        if (all.empty() || all.back().kind != Kind::kEnvironment) return std::nullopt;
+        return all.size() - 1;
     }
 
   private:
-    std::vector<Emitter> emitters_;
-    std::unordered_map<const Object*, std::size_t> by_object_;
+    struct Data {
+        std::vector<Emitter> emitters;
+        std::unordered_map<const Object*, std::size_t> by_object;
+    };
+    // Shared by copies: a render's two plans (render_context.h) hold the same emitters, whose
+    // data for an emitting mesh is over a hundred bytes a triangle.
+    std::shared_ptr<const Data> data_ = std::make_shared<const Data>();
 };
 
 }  // namespace drt
