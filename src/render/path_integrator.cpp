@@ -144,12 +144,7 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
         // Each part is picked in proportion to its weight and then carries its own over the
         // pick's probability.
         const Color diffuse_colour = m.diffuse * surface.kd;
-        const double diffuse_weight =
-            m.has_diffuse() ? std::max(0.0, luminance(diffuse_colour)) : 0;
-        const double reflect_weight =
-            m.reflects() ? std::max(0.0, m.reflective * luminance(m.ks)) : 0;
-        const double transmit_weight =
-            m.transmits() ? std::max(0.0, m.transmit * luminance(m.kt)) : 0;
+        const auto [diffuse_weight, reflect_weight, transmit_weight] = m.part_weights(surface.kd);
         const double total = diffuse_weight + reflect_weight + transmit_weight;
         if (!(total > 0)) return result;
         const double diffuse_pick = diffuse_weight / total;

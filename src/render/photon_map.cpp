@@ -333,12 +333,7 @@ bool PhotonMaps::trace_one(std::uint64_t key, Photon& out) const {
 
         // The parts are picked as the path integrator picks them; a diffuse pick stores the
         // photon (divided by the pick's probability) and ends it.
-        const double diffuse_weight =
-            m.has_diffuse() ? std::max(0.0, luminance(m.diffuse * surface.kd)) : 0;
-        const double reflect_weight =
-            m.reflects() ? std::max(0.0, m.reflective * luminance(m.ks)) : 0;
-        const double transmit_weight =
-            m.transmits() ? std::max(0.0, m.transmit * luminance(m.kt)) : 0;
+        const auto [diffuse_weight, reflect_weight, transmit_weight] = m.part_weights(surface.kd);
         const double total = diffuse_weight + reflect_weight + transmit_weight;
         if (!(total > 0)) return false;
         const std::uint32_t base = kFirstEvent + static_cast<std::uint32_t>(events) * kPerEvent;

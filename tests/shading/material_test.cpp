@@ -47,5 +47,22 @@ TEST(Refract, NoDirectionUnderTotalInternalReflection) {
     EXPECT_FALSE(refract(d, {0, 1, 0}, 1.5));
 }
 
+// A path picks a part in proportion to the luminance of what it passes on; a part the material
+// lacks (its factor 0, or a black colour) weighs nothing.
+TEST(Material, PartWeightsAreTheLuminanceOfWhatEachPartPassesOn) {
+    Material m;
+    m.diffuse = 0.5;
+    m.reflective = 0.25;
+    m.ks = {1, 0, 0};
+    m.transmit = 0.75;
+    m.kt = {0, 0, 0};                                           // black: no transparent part
+    const Material::PartWeights w = m.part_weights({0, 1, 0});  // the point's kd, textured
+    EXPECT_DOUBLE_EQ(w.diffuse, 0.5 * 0.7152);
+    EXPECT_DOUBLE_EQ(w.reflect, 0.25 * 0.2126);
+    EXPECT_EQ(w.transmit, 0);
+    m.diffuse = 0;
+    EXPECT_EQ(m.part_weights({1, 1, 1}).diffuse, 0);
+}
+
 }  // namespace
 }  // namespace drt

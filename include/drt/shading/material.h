@@ -3,6 +3,7 @@
 // it is a value type rather than a class hierarchy.
 #pragma once
 
+#include <algorithm>
 #include <optional>
 #include <string>
 
@@ -38,6 +39,18 @@ struct Material {
     bool transmits() const { return transmit > 0 && !is_black(kt); }
     bool has_diffuse() const { return diffuse > 0; }
     bool emits() const { return !is_black(emission); }
+
+    // What a path (or a photon) picks one part by, in proportion: each part's weight, the
+    // luminance of what it passes on (`kd`: the diffuse colour at the point, textured or not);
+    // 0 for a part the material does not have.
+    struct PartWeights {
+        double diffuse, reflect, transmit;
+    };
+    PartWeights part_weights(const Color& kd) const {
+        return {has_diffuse() ? std::max(0.0, luminance(diffuse * kd)) : 0,
+                reflects() ? std::max(0.0, reflective * luminance(ks)) : 0,
+                transmits() ? std::max(0.0, transmit * luminance(kt)) : 0};
+    }
 };
 
 // Fraction of unpolarised light reflected at a smooth interface (exact Fresnel equations).
