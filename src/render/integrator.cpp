@@ -62,13 +62,8 @@ Color Integrator::radiance(const Ray& ray, const PixelSample& s, int depth, Pixe
                            Leaving leaving, double throughput) const {
     const auto hit = bvh_.intersect(ray, {0, kInfinity}, leaving);
     if (any_visible_light_) {
-        double nearest = hit ? hit->t : kInfinity;
-        const Light* seen = nullptr;
-        for (const auto& light : scene_.lights) {
-            if (!light->visible()) continue;
-            if (auto t = light->intersect(ray, {0, nearest})) nearest = *t, seen = light.get();
-        }
-        if (seen) return seen->intensity();
+        if (const Light* seen = first_visible_light(scene_.lights, ray, hit ? hit->t : kInfinity))
+            return seen->intensity();
     }
     if (!hit) return scene_.environment ? scene_.environment->radiance(ray.dir) : scene_.background;
 

@@ -95,13 +95,10 @@ Color PathIntegrator::radiance(const Ray& camera_ray, const PixelSample& s,
         // The thesis's visible lights are seen as in the distributed integrator; light from them
         // reaches diffuse surfaces by shadow rays alone.
         if (any_visible_light_ && !after_diffuse) {
-            double nearest = hit ? hit->t : kInfinity;
-            const Light* seen = nullptr;
-            for (const auto& light : scene_.lights) {
-                if (!light->visible()) continue;
-                if (auto t = light->intersect(ray, {0, nearest})) nearest = *t, seen = light.get();
+            if (const Light* seen =
+                    first_visible_light(scene_.lights, ray, hit ? hit->t : kInfinity)) {
+                return result + throughput * seen->intensity();
             }
-            if (seen) return result + throughput * seen->intensity();
         }
         if (!hit && !scene_.environment) return result + throughput * scene_.background;
         if (!hit) {

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -250,6 +251,22 @@ TEST(LightSampleCone, DirectionsStayInTheConeAndAreUniformInSolidAngle) {
     // The rim and the axis.
     EXPECT_NEAR(sample_cone({1, 0}, 0.5).z, 0.5, 1e-15);
     EXPECT_EQ(sample_cone({0, 0.3}, 0.5).z, 1.0);
+}
+
+// A ray sees the nearest visible light in front of its hit; invisible lights and points are not
+// seen at all.
+TEST(FirstVisibleLight, TheNearestVisibleLightBeforeTheHit) {
+    std::vector<std::unique_ptr<Light>> lights;
+    lights.push_back(std::make_unique<SphereLight>(Vec3{0, 0, 10}, 1, Color{1, 0, 0}, true));
+    lights.push_back(std::make_unique<SphereLight>(Vec3{0, 0, 5}, 1, Color{0, 1, 0}, true));
+    lights.push_back(std::make_unique<SphereLight>(Vec3{0, 0, 2}, 0.5, Color{0, 0, 1}, false));
+    lights.push_back(std::make_unique<PointLight>(Vec3{0, 0, 1}, Color{1, 1, 1}));
+    const Ray ray{{0, 0, 0}, {0, 0, 1}, 0};
+    EXPECT_EQ(first_visible_light(lights, ray, kInfinity), lights[1].get());  // enters at 4
+    EXPECT_EQ(first_visible_light(lights, ray, 4.5), lights[1].get());
+    EXPECT_EQ(first_visible_light(lights, ray, 3.5), nullptr);  // the hit is nearer
+    const Ray aside{{3, 0, 0}, {0, 0, 1}, 0};
+    EXPECT_EQ(first_visible_light(lights, aside, kInfinity), nullptr);
 }
 
 }  // namespace

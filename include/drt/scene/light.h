@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cmath>
+#include <memory>
 #include <optional>
 #include <span>
 
@@ -51,6 +52,18 @@ class Light {
     Color intensity_;
     bool visible_;
 };
+
+// The visible light `ray` enters first, nearer than `nearest` (the ray's hit), if any: what a
+// camera or reflected ray sees of the thesis's lights, which are not in the BVH.
+inline const Light* first_visible_light(std::span<const std::unique_ptr<Light>> lights,
+                                        const Ray& ray, double nearest) {
+    const Light* seen = nullptr;
+    for (const auto& light : lights) {
+        if (!light->visible()) continue;
+        if (auto t = light->intersect(ray, {0, nearest})) nearest = *t, seen = light.get();
+    }
+    return seen;
+}
 
 class PointLight final : public Light {
   public:
