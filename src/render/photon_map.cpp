@@ -149,13 +149,18 @@ Color PhotonPass::estimate(const Vec3& point, const Vec3& normal) const {
     return Color{sum[0], sum[1], sum[2]} / area;
 }
 
+double first_photon_radius(const Scene& scene) {
+    const auto& photons = scene.settings.photons;
+    return photons && photons->radius > 0 ? photons->radius : default_photon_radius(scene);
+}
+
 // --- the passes ---
 
 PhotonMaps::PhotonMaps(const Scene& scene, const RenderPlan& plan, const Bvh& bvh)
     : scene_(scene), plan_(plan), bvh_(bvh) {
     const PhotonSettings settings = scene.settings.photons.value_or(PhotonSettings{});
     count_ = settings.count;
-    radius_ = settings.radius > 0 ? settings.radius : default_photon_radius(scene);
+    radius_ = first_photon_radius(scene);
     double total = 0;
     for (std::size_t i = 0; i < plan.emitters.size(); ++i) {
         const Emitters::Emitter& e = plan.emitters[i];

@@ -179,10 +179,9 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
     if (s.photons) {
         out << "  caustics: " << flag(e.caustics);
         if (e.caustics) {
-            const double radius =
-                s.photons->radius > 0 ? s.photons->radius : default_photon_radius(scene);
             out << " (photon maps: " << s.photons->count
-                << " photons a pass, one pass a sample; first gather radius " << radius << ")";
+                << " photons a pass, one pass a sample; first gather radius "
+                << first_photon_radius(scene) << ")";
         } else {
             out << " (<Photons> given, but no Falloff-1 light or emitter, reflective or "
                    "transparent surface and diffuse surface together)";

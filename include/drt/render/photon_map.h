@@ -113,5 +113,7 @@ class PhotonMaps {
 // The first pass's radius drt takes without a Radius attribute: 1/100 of the diagonal of the box
 // around the scene's spheres and meshes at time 0 (1 if there are none).
 double default_photon_radius(const Scene& scene);
+// The first pass's radius: the scene's <Photons Radius>, or the default.
+double first_photon_radius(const Scene& scene);
 
 }  // namespace drt
