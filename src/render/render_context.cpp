@@ -394,6 +394,7 @@ std::size_t RenderContext::help(Workbench& bench, const std::stop_token& stop) c
             run->helped.fetch_add(1, std::memory_order_release);
             run->helped.notify_one();
             if (error) std::rethrow_exception(error);
+            if (stopped) return rendered;
             ++rendered;
         }
     }

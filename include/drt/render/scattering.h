@@ -91,8 +91,8 @@ Vec3 perturb_on_side(const Vec3& ideal, double sigma, double side, const Vec3& g
     }
 }
 
-// Russian roulette starts at this scattering event (0 = the first hit), in the path integrator
-// and in the photons' paths: the first bounces carry most of the light and stay whole.
+// Scattering events a path (or a photon's path) takes before Russian roulette may end it: the
+// first bounces carry most of the light and are never cut short.
 inline constexpr int kRouletteStart = 3;
 
 }  // namespace drt
