@@ -1,8 +1,10 @@
 #include "drt/render/path_integrator.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
+#include "drt/accel/occluders.h"
 #include "drt/render/scattering.h"
 #include "drt/sampling/cdf_pick.h"
 #include "drt/util/rng.h"
@@ -227,14 +229,13 @@ Vec3 PathIntegrator::perturbed(const Vec3& ideal, double sigma, double side, con
                            });
 }
 
-Color PathIntegrator::light_ray(const Light& light, Vec2 u, const Vec3& point, const Vec3& origin,
+Color PathIntegrator::light_ray(const Light& light, const LightSample& ls, const Vec3& origin,
                                 Leaving leaving, const Vec3& geometric, const Vec3& shading,
-                                double time, RayCounts& counts) const {
-    const LightSample ls = light.sample(point, u);
+                                double time, const Occluders& occluders, RayCounts& counts) const {
     const double cosine = lit_cosine(ls.dir, shading, geometric);
     if (cosine == 0) return {};
     ++counts.shadow;
-    if (bvh_.occluded({origin, ls.dir, time}, {0, ls.distance}, leaving)) return {};
+    if (occluders.occluded(bvh_, {origin, ls.dir, time}, {0, ls.distance}, leaving)) return {};
     return light.intensity() * cosine;
 }
 
@@ -259,16 +260,39 @@ Color PathIntegrator::next_event(const Vec3& point, const Vec3& geometric, const
                                  double diffuse_pick, RayCounts& counts) const {
     const Vec3 origin = spawn_ray(point, geometric, geometric, time).origin;
     const bool emitters = strategy_ != Strategy::kScatterOnly;
+    constexpr int kChunk = 16;
+    std::array<Vec2, kChunk> points;
+    std::array<LightSample, kChunk> samples;
     Color sum;
     for (std::size_t i = 0; i < scene_.lights.size(); ++i) {
         const int rays = plan_.shadow_rays[i];
+        if (rays == 0) continue;
+        const Light& light = *scene_.lights[i];
+        // What can block this point's rays to the light, found once for all of them, as the
+        // distributed integrator finds it (occluders.h): the answers are the tree's.
+        const Occluders occluders =
+            worth_culling(rays, bvh_) ? Occluders(bvh_, origin, light.extent(), time) : Occluders{};
+        // The points come a chunk at a time, so that what a set shares (its key, the light's
+        // cone) is worked out once, as in the distributed integrator: the same numbers as one
+        // at a time (sampler.h, light.h).
+        const std::uint32_t dimension = path_dim::light(depth, i);
         Color light_sum;
-        for (int j = 0; j < rays; ++j) {
-            light_sum += light_ray(*scene_.lights[i],
-                                   sampler_.get_2d_for_ray(s, path_dim::light(depth, i), j, rays),
-                                   point, origin, leaving, geometric, shading, time, counts);
+        for (int first = 0; first < rays; first += kChunk) {
+            const auto n = static_cast<std::size_t>(std::min(kChunk, rays - first));
+            if (rays == 1) {
+                points[0] = sampler_.get_2d(s, dimension);
+            } else {
+                sampler_.get_2d_set(s, dimension, static_cast<std::uint32_t>(rays),
+                                    static_cast<std::uint32_t>(first), std::span(points).first(n));
+            }
+            light.sample(point, std::span<const Vec2>(points).first(n),
+                         std::span(samples).first(n));
+            for (std::size_t j = 0; j < n; ++j) {
+                light_sum += light_ray(light, samples[j], origin, leaving, geometric, shading, time,
+                                       occluders, counts);
+            }
         }
-        if (rays > 0) sum += light_sum / rays;
+        sum += light_sum / rays;
     }
     for (std::size_t i = 0; emitters && i < plan_.emitters.size(); ++i) {
         const int rays = plan_.emitter_rays[i];
@@ -290,8 +314,9 @@ Color PathIntegrator::next_event(const Vec3& point, const Vec3& geometric, const
             const auto [k, p, rest] = pick_from_cdf(plan_.light_pick_cdf, u.x);
             u.x = rest;
             if (k < area_lights_.size()) {
-                sum += light_ray(*area_lights_[k], u, point, origin, leaving, geometric, shading,
-                                 time, counts) /
+                const Light& light = *area_lights_[k];
+                sum += light_ray(light, light.sample(point, u), origin, leaving, geometric, shading,
+                                 time, Occluders{}, counts) /
                        (p * rays);
             } else if (emitters) {
                 sum += emitter_ray(plan_.area_emitters[k - area_lights_.size()], u, point, origin,

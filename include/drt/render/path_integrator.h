@@ -22,6 +22,8 @@
 
 namespace drt {
 
+class Occluders;
+
 class PathIntegrator final : public PixelIntegrator {
   public:
     // How light from emitters reaching a diffuse surface is found: by both next-event estimation
@@ -50,9 +52,9 @@ class PathIntegrator final : public PixelIntegrator {
     Color next_event(const Vec3& point, const Vec3& geometric, const Vec3& shading, Leaving leaving,
                      double time, const PixelSample& s, int depth, double diffuse_pick,
                      RayCounts& counts) const;
-    Color light_ray(const Light& light, Vec2 u, const Vec3& point, const Vec3& origin,
-                    Leaving leaving, const Vec3& geometric, const Vec3& shading, double time,
-                    RayCounts& counts) const;
+    Color light_ray(const Light& light, const LightSample& ls, const Vec3& origin, Leaving leaving,
+                    const Vec3& geometric, const Vec3& shading, double time,
+                    const Occluders& occluders, RayCounts& counts) const;
     Color emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point, const Vec3& origin,
                       Leaving leaving, const Vec3& geometric, const Vec3& shading, double time,
                       double diffuse_pick, RayCounts& counts) const;
