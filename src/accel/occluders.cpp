@@ -44,7 +44,8 @@ struct SegmentCone {
 
 }  // namespace
 
-Occluders::Occluders(const Bvh& bvh, const Vec3& origin, const Ball& target, double time) {
+Occluders::Occluders(const Bvh& bvh, const Vec3& origin, const Ball& target, double time,
+                     const Object* target_sphere) {
     const double slack =
         kSlack * (max_abs_component(origin) + max_abs_component(target.centre) + target.radius);
     const Vec3 w = target.centre - origin;
@@ -83,6 +84,7 @@ Occluders::Occluders(const Bvh& bvh, const Vec3& origin, const Ball& target, dou
     const bool listed = bvh.visit_near(
         time, [&](const Ball& ball) { return cone.may_meet(ball); },
         [&](std::uint32_t primitive) {
+            if (target_sphere && bvh.is_sphere_of(primitive, target_sphere)) return true;
             if (count_ == kMaxListed) return false;  // too many: traverse instead
             primitives_[count_++] = primitive;
             return true;

@@ -221,11 +221,12 @@ Color Integrator::light_ray(const Light& light, const LightSample& ls, const Vec
     return light.intensity() * cosine;
 }
 
-Color Integrator::emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point, const Vec3& origin,
-                              Leaving leaving, const Vec3& geometric, const Vec3& shading,
-                              double time, RayCounts& counts) const {
-    const auto reached = reach_emitter(plan_.emitters, bvh_, emitter, u, point, origin, leaving,
-                                       geometric, shading, time, counts);
+Color Integrator::emitter_ray(std::size_t emitter, const std::optional<EmitterSample>& drawn,
+                              const Vec3& origin, Leaving leaving, const Vec3& geometric,
+                              const Vec3& shading, double time, const Occluders& occluders,
+                              RayCounts& counts) const {
+    const auto reached = reach_emitter(plan_.emitters, bvh_, occluders, emitter, drawn, origin,
+                                       leaving, geometric, shading, time, counts);
     if (!reached) return {};
     const auto& [sample, cosine, point_light] = *reached;
     // In the units of the thesis's sum of lights, which the diffuse part multiplies by
@@ -290,11 +291,18 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
         const int rays = plan_.emitter_rays[i];
         if (rays == 0) continue;
         const std::uint32_t dimension = dim::light(depth, scene_.lights.size() + i);
+        const Occluders occluders = emitter_occluders(plan_.emitters, bvh_, i, rays, origin, time);
+        std::array<std::optional<EmitterSample>, kChunk> emitter_samples;
         Color emitter_sum;
-        for (int j = 0; j < rays; ++j) {
-            const Vec2 u = sampler_.get_2d_for_ray(s, dimension, j, rays);
-            emitter_sum +=
-                emitter_ray(i, u, point, origin, leaving, geometric, shading, time, counts);
+        for (int first = 0; first < rays; first += kChunk) {
+            const auto n = static_cast<std::size_t>(std::min(kChunk, rays - first));
+            sampler_.get_2d_for_rays(s, dimension, rays, first, std::span(points).first(n));
+            plan_.emitters.sample(i, point, std::span<const Vec2>(points).first(n), time,
+                                  std::span(emitter_samples).first(n));
+            for (std::size_t j = 0; j < n; ++j) {
+                emitter_sum += emitter_ray(i, emitter_samples[j], origin, leaving, geometric,
+                                           shading, time, occluders, counts);
+            }
         }
         sum += rays == 1 ? emitter_sum : emitter_sum / rays;
     }
@@ -309,8 +317,8 @@ Color Integrator::direct_light(const Vec3& point, const Vec3& geometric, const V
             u.x = rest;
             if (k >= area_lights_.size()) {
                 const std::size_t emitter = plan_.area_emitters[k - area_lights_.size()];
-                sum += emitter_ray(emitter, u, point, origin, leaving, geometric, shading, time,
-                                   counts) /
+                sum += emitter_ray(emitter, plan_.emitters.sample(emitter, point, u, time), origin,
+                                   leaving, geometric, shading, time, Occluders{}, counts) /
                        (p * rays);
                 continue;
             }

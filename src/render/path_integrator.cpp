@@ -239,12 +239,12 @@ Color PathIntegrator::light_ray(const Light& light, const LightSample& ls, const
     return light.intensity() * cosine;
 }
 
-Color PathIntegrator::emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point,
+Color PathIntegrator::emitter_ray(std::size_t emitter, const std::optional<EmitterSample>& drawn,
                                   const Vec3& origin, Leaving leaving, const Vec3& geometric,
                                   const Vec3& shading, double time, double diffuse_pick,
-                                  RayCounts& counts) const {
-    const auto reached = reach_emitter(plan_.emitters, bvh_, emitter, u, point, origin, leaving,
-                                       geometric, shading, time, counts);
+                                  const Occluders& occluders, RayCounts& counts) const {
+    const auto reached = reach_emitter(plan_.emitters, bvh_, occluders, emitter, drawn, origin,
+                                       leaving, geometric, shading, time, counts);
     if (!reached) return {};
     const auto& [sample, cosine, point_light] = *reached;
     if (point_light) return sample.radiance * cosine;
@@ -279,12 +279,7 @@ Color PathIntegrator::next_event(const Vec3& point, const Vec3& geometric, const
         Color light_sum;
         for (int first = 0; first < rays; first += kChunk) {
             const auto n = static_cast<std::size_t>(std::min(kChunk, rays - first));
-            if (rays == 1) {
-                points[0] = sampler_.get_2d(s, dimension);
-            } else {
-                sampler_.get_2d_set(s, dimension, static_cast<std::uint32_t>(rays),
-                                    static_cast<std::uint32_t>(first), std::span(points).first(n));
-            }
+            sampler_.get_2d_for_rays(s, dimension, rays, first, std::span(points).first(n));
             light.sample(point, std::span<const Vec2>(points).first(n),
                          std::span(samples).first(n));
             for (std::size_t j = 0; j < n; ++j) {
@@ -296,14 +291,28 @@ Color PathIntegrator::next_event(const Vec3& point, const Vec3& geometric, const
     }
     for (std::size_t i = 0; emitters && i < plan_.emitters.size(); ++i) {
         const int rays = plan_.emitter_rays[i];
+        if (rays == 0) continue;
         const std::uint32_t dimension = path_dim::light(depth, scene_.lights.size() + i);
-        Color emitter_sum;
-        for (int j = 0; j < rays; ++j) {
-            emitter_sum +=
-                emitter_ray(i, sampler_.get_2d_for_ray(s, dimension, j, rays), point, origin,
-                            leaving, geometric, shading, time, diffuse_pick, counts);
+        if (rays == 1) {  // the common case, without a set's arrays
+            sum += emitter_ray(
+                i, plan_.emitters.sample(i, point, sampler_.get_2d(s, dimension), time), origin,
+                leaving, geometric, shading, time, diffuse_pick, Occluders{}, counts);
+            continue;
         }
-        if (rays > 0) sum += emitter_sum / rays;
+        const Occluders occluders = emitter_occluders(plan_.emitters, bvh_, i, rays, origin, time);
+        std::array<std::optional<EmitterSample>, kChunk> emitter_samples;
+        Color emitter_sum;
+        for (int first = 0; first < rays; first += kChunk) {
+            const auto n = static_cast<std::size_t>(std::min(kChunk, rays - first));
+            sampler_.get_2d_for_rays(s, dimension, rays, first, std::span(points).first(n));
+            plan_.emitters.sample(i, point, std::span<const Vec2>(points).first(n), time,
+                                  std::span(emitter_samples).first(n));
+            for (std::size_t j = 0; j < n; ++j) {
+                emitter_sum += emitter_ray(i, emitter_samples[j], origin, leaving, geometric,
+                                           shading, time, diffuse_pick, occluders, counts);
+            }
+        }
+        sum += emitter_sum / rays;
     }
     if (plan_.shared_rays > 0) {
         // Each ray picks a light or an emitter in proportion to power and is divided by the
@@ -319,8 +328,10 @@ Color PathIntegrator::next_event(const Vec3& point, const Vec3& geometric, const
                                  time, Occluders{}, counts) /
                        (p * rays);
             } else if (emitters) {
-                sum += emitter_ray(plan_.area_emitters[k - area_lights_.size()], u, point, origin,
-                                   leaving, geometric, shading, time, diffuse_pick, counts) /
+                const std::size_t emitter = plan_.area_emitters[k - area_lights_.size()];
+                sum += emitter_ray(emitter, plan_.emitters.sample(emitter, point, u, time), origin,
+                                   leaving, geometric, shading, time, diffuse_pick, Occluders{},
+                                   counts) /
                        (p * rays);
             }
         }

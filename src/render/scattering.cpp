@@ -45,11 +45,11 @@ Vec3 perturb_direction(const Vec3& ideal, double sigma, Vec2 u) {
 }
 
 std::optional<ReachingEmitter> reach_emitter(const Emitters& emitters, const Bvh& bvh,
-                                             std::size_t emitter, Vec2 u, const Vec3& point,
+                                             const Occluders& occluders, std::size_t emitter,
+                                             const std::optional<EmitterSample>& sample,
                                              const Vec3& origin, Leaving leaving,
                                              const Vec3& geometric, const Vec3& shading,
                                              double time, RayCounts& counts) {
-    const auto sample = emitters.sample(emitter, point, u, time);
     if (!sample) return std::nullopt;
     const double cosine = lit_cosine(sample->dir, shading, geometric);
     if (cosine == 0) return std::nullopt;
@@ -57,8 +57,22 @@ std::optional<ReachingEmitter> reach_emitter(const Emitters& emitters, const Bvh
     const bool point_light = emitters.is_point(emitter);
     // An emitting surface is in the BVH: the ray stops just short of it.
     const double reach = point_light ? sample->distance : sample->distance * kShortOfEmitter;
-    if (bvh.occluded({origin, sample->dir, time}, {0, reach}, leaving)) return std::nullopt;
+    if (occluders.occluded(bvh, {origin, sample->dir, time}, {0, reach}, leaving)) {
+        return std::nullopt;
+    }
     return ReachingEmitter{*sample, cosine, point_light};
+}
+
+Occluders emitter_occluders(const Emitters& emitters, const Bvh& bvh, std::size_t emitter, int rays,
+                            const Vec3& origin, double time) {
+    if (!worth_culling(rays, bvh)) return {};
+    const auto extent = emitters.extent(emitter, time);
+    if (!extent) return {};
+    // A sphere's samples lie on the part of it seen from the point (or, from inside, where a
+    // ray leaves it), and the rays stop short of them: the sphere cannot block its own light.
+    const Emitters::Emitter& e = emitters[emitter];
+    const Object* sphere = e.kind == Emitters::Kind::kSphere ? e.object : nullptr;
+    return Occluders(bvh, origin, *extent, time, sphere);
 }
 
 }  // namespace drt

@@ -50,6 +50,28 @@ std::optional<SphericalTriangle> by_solid_angle(const Emitters::Emitter::Triangl
     return std::nullopt;
 }
 
+// The cone of directions a sphere of radius r subtends from a point outside it, at squared
+// distance d2 from its centre along `to_centre`: what every sample from that point shares.
+struct SphereCone {
+    double d, d2, r, cos_max, pdf;
+    Frame frame;  // n towards the centre
+
+    SphereCone(const Vec3& to_centre, double d2_, double radius)
+        : d(std::sqrt(d2_)),
+          d2(d2_),
+          r(radius),
+          cos_max(std::sqrt(std::max(0.0, 1 - radius * radius / d2_))),
+          pdf(1 / (2 * kPi * sphere_cone_one_minus_cos(d2_, radius))),
+          frame(Frame::around(to_centre / d)) {}
+
+    EmitterSample sample(Vec2 u, const Color& radiance) const {
+        const ConeCoordinates c = cone_coordinates(u, cos_max);
+        const Vec3 dir = normalize(frame.to_world({c.x, c.y, c.cos_t}));
+        const double distance = d * c.cos_t - std::sqrt(positive_part(r * r - d2 * c.sin2_t));
+        return EmitterSample{dir, distance, radiance, pdf};
+    }
+};
+
 }  // namespace
 
 Emitters::Emitters(const Scene& scene) {
@@ -127,6 +149,20 @@ Emitters::Emitters(const Scene& scene) {
     data_ = std::move(data);
 }
 
+std::optional<Ball> Emitters::extent(std::size_t i, double time) const {
+    const Emitter& e = data_->emitters[i];
+    switch (e.kind) {
+        case Kind::kPoint:
+            return Ball{e.position, 0};
+        case Kind::kSphere:
+            return Ball{e.path->at(time), e.radius};
+        case Kind::kTriangles:
+        case Kind::kEnvironment:
+            return std::nullopt;
+    }
+    return std::nullopt;
+}
+
 std::optional<std::size_t> Emitters::index_of(const Object* object) const {
     const auto it = data_->by_object.find(object);
     if (it == data_->by_object.end()) return std::nullopt;
@@ -154,14 +190,7 @@ std::optional<EmitterSample> Emitters::sample(std::size_t i, const Vec3& x, Vec2
                 if (!t) return std::nullopt;
                 return EmitterSample{dir, *t, e.radiance, 1 / (4 * kPi)};
             }
-            const double d = std::sqrt(d2);
-            const double cos_max = std::sqrt(std::max(0.0, 1 - e.radius * e.radius / d2));
-            const ConeCoordinates c = cone_coordinates(u, cos_max);
-            const Vec3 dir = normalize(Frame::around(to_centre / d).to_world({c.x, c.y, c.cos_t}));
-            const double distance =
-                d * c.cos_t - std::sqrt(positive_part(e.radius * e.radius - d2 * c.sin2_t));
-            return EmitterSample{dir, distance, e.radiance,
-                                 1 / (2 * kPi * sphere_cone_one_minus_cos(d2, e.radius))};
+            return SphereCone(to_centre, d2, e.radius).sample(u, e.radiance);
         }
         case Kind::kTriangles: {
             const auto [k, pick, v] = pick_from_cdf(e.area_cdf, u.x);
@@ -196,6 +225,21 @@ std::optional<EmitterSample> Emitters::sample(std::size_t i, const Vec3& x, Vec2
         }
     }
     return std::nullopt;
+}
+
+void Emitters::sample(std::size_t i, const Vec3& x, std::span<const Vec2> u, double time,
+                      std::span<std::optional<EmitterSample>> out) const {
+    const Emitter& e = data_->emitters[i];
+    if (e.kind == Kind::kSphere) {
+        const Vec3 to_centre = e.path->at(time) - x;
+        const double d2 = dot(to_centre, to_centre);
+        if (!inside_sphere(d2, e.radius)) {
+            const SphereCone cone(to_centre, d2, e.radius);
+            for (std::size_t k = 0; k < u.size(); ++k) out[k] = cone.sample(u[k], e.radiance);
+            return;
+        }
+    }
+    for (std::size_t k = 0; k < u.size(); ++k) out[k] = sample(i, x, u[k], time);
 }
 
 double Emitters::pdf(std::size_t i, const Vec3& x, const Vec3& point, const Vec3& normal,

@@ -187,5 +187,57 @@ TEST(Occluders, PassTheTriangleARayLeavesOnToTheTree) {
     }
 }
 
+// Shadow rays to points on the side of an emitting sphere seen from the shading point, stopped
+// short of it as next-event estimation stops them: with the sphere named as the target it is
+// not gathered as an occluder of its own light, and the answers stay the tree's; a sphere alone
+// in a room then needs no ray at all.
+TEST(Occluders, ATargetSphereIsNotItsOwnOccluder) {
+    const World world(12, 70);
+    const Bvh bvh(world.objects);
+    int rays = 0, blocked = 0, fewer = 0;
+    for (std::uint64_t p = 0; p < 300; ++p) {
+        const auto* sphere = dynamic_cast<const Sphere*>(world.objects[3 + p % 12].get());
+        const double time = 2.5 * unit(71, p);
+        const Ball target{sphere->path().at(time), sphere->radius()};
+        const Vec3 origin = point_in(72, p, 5, 95);
+        const Vec3 to_centre = target.centre - origin;
+        const double d = length(to_centre);
+        if (d <= target.radius * 1.01) continue;
+        const Occluders all(bvh, origin, target, time);
+        const Occluders others(bvh, origin, target, time, sphere);
+        fewer += others.count() < all.count() || others.reach() != all.reach();
+        for (std::uint64_t j = 0; j < 20; ++j) {
+            // A point of the visible cap: a direction within the sphere's cone, to its near hit.
+            const double cos_max = std::sqrt(1 - target.radius * target.radius / (d * d));
+            const double cos_t = 1 - unit(73, p * 20 + j) * (1 - cos_max);
+            const Vec3 local = direction(74, p * 20 + j);
+            const Frame frame = Frame::around(to_centre / d);
+            const Vec3 side = normalize(frame.to_world({local.x, local.y, 0}));
+            const Vec3 dir =
+                normalize(frame.n * cos_t + side * std::sqrt(std::max(0.0, 1 - cos_t * cos_t)));
+            const auto hit = sphere->intersect({origin, dir, time}, {0, kInfinity});
+            if (!hit) continue;
+            const Ray ray{origin, dir, time};
+            const Interval range{0, hit->t * (1 - 1e-5)};
+            const bool expected = bvh.occluded(ray, range);
+            ASSERT_EQ(others.occluded(bvh, ray, range), expected) << p << " " << j;
+            blocked += expected, ++rays;
+        }
+    }
+    EXPECT_GT(rays, 3000);
+    EXPECT_GT(blocked, rays / 50);
+    EXPECT_GT(fewer, 200);
+
+    Material material;
+    std::vector<std::unique_ptr<Object>> objects;
+    objects.push_back(std::make_unique<Plane>(Vec3{0, 0, 0}, Vec3{0, 1, 0}, material));
+    objects.push_back(std::make_unique<Sphere>(std::vector<Vec3>{{0, 50, 0}}, 5.0, material));
+    const Bvh room(objects);
+    const Ball lamp{{0, 50, 0}, 5};
+    EXPECT_EQ(Occluders(room, {20, 1, 0}, lamp, 0).reach(), Occluders::Reach::kListed);
+    EXPECT_EQ(Occluders(room, {20, 1, 0}, lamp, 0, objects[1].get()).reach(),
+              Occluders::Reach::kNothing);
+}
+
 }  // namespace
 }  // namespace drt

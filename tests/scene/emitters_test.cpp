@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "drt/accel/mesh.h"
+#include "drt/geometry/sphere.h"
 #include "drt/scene/scene_loader.h"
 #include "test_math.h"
 #include "test_meshes.h"
@@ -298,6 +299,61 @@ TEST(Emitters, IrradianceUnderATriangleIsLambertsWithLessVarianceThanByArea) {
         EXPECT_NEAR(by_area.mean, expected, 4 * std::sqrt(by_area.variance / n)) << view.x.y;
         EXPECT_LT(solid.variance, (view.near ? 0.05 : 0.5) * by_area.variance) << view.x.y;
     }
+}
+
+// A set of next-event samples drawn at once (what the integrators draw for several shadow rays)
+// is the samples drawn one by one, bit for bit, for a moving emitting sphere seen from outside
+// and from inside, a Falloff-1 point light and a mesh; and every point sampled on a sphere or a
+// point light lies in the extent that shadow-ray culling gathers occluders for.
+TEST(Emitters, ASetOfSamplesIsItsSamplesOneByOneWithinTheExtent) {
+    auto q = quad_scene();
+    Scene& scene = q->scene;
+    Material glow;
+    glow.name = "sphere glow";
+    glow.emission = {2, 1, 0.5};
+    const Material& m = testing::add_material(scene, glow);
+    const double radius = 0.75;
+    scene.objects.push_back(
+        std::make_unique<Sphere>(std::vector<Vec3>{{1, 2, 3}, {2, 2.5, 3}}, radius, m));
+    scene.inverse_square_lights.push_back({{-2, 4, 1}, {30, 30, 30}});
+    const Emitters emitters(scene);
+    ASSERT_EQ(emitters.size(), 3u);  // the point light, the quad, the sphere
+    const std::size_t point = 0, quad = 1, sphere = 2;
+    EXPECT_FALSE(emitters.extent(quad, 0).has_value());
+    constexpr int kCount = 7;
+    std::array<Vec2, kCount> u;
+    std::array<std::optional<EmitterSample>, kCount> set;
+    int outside = 0, inside = 0;
+    for (std::uint64_t p = 0; p < 200; ++p) {
+        const double time = unit(60, p);
+        const Vec3 centre = Vec3{1, 2, 3} + Vec3{1, 0.5, 0} * time;
+        // Every fourth point inside the sphere, the others around it.
+        const Vec3 x = p % 4 == 0 ? centre + testing::unit_vector(61, p) * (0.9 * radius)
+                                  : centre + Vec3{6 * unit(62, p) - 3, 6 * unit(63, p) - 3,
+                                                  6 * unit(64, p) - 3};
+        ++(length(x - centre) < radius ? inside : outside);
+        for (int k = 0; k < kCount; ++k)
+            u[k] = {unit(65, p * kCount + k), unit(66, p * kCount + k)};
+        for (const std::size_t i : {point, quad, sphere}) {
+            emitters.sample(i, x, u, time, set);
+            const auto extent = emitters.extent(i, time);
+            for (int k = 0; k < kCount; ++k) {
+                const auto one = emitters.sample(i, x, u[k], time);
+                ASSERT_EQ(one.has_value(), set[k].has_value()) << i << " " << p << " " << k;
+                if (!one) continue;
+                EXPECT_EQ(one->dir, set[k]->dir) << i << " " << p << " " << k;
+                EXPECT_EQ(one->distance, set[k]->distance) << i << " " << p << " " << k;
+                EXPECT_EQ(one->radiance, set[k]->radiance) << i << " " << p << " " << k;
+                EXPECT_EQ(one->pdf, set[k]->pdf) << i << " " << p << " " << k;
+                if (!extent) continue;
+                const Vec3 sampled = x + one->dir * one->distance;
+                EXPECT_LE(length(sampled - extent->centre), extent->radius * (1 + 1e-12) + 1e-12)
+                    << i << " " << p << " " << k;
+            }
+        }
+    }
+    EXPECT_GT(inside, 40);
+    EXPECT_GT(outside, 100);
 }
 
 }  // namespace

@@ -56,6 +56,12 @@ class Bvh {
     // The same, testing only the listed primitives (as visit_near names them) of the tree.
     bool occluded_by(const Ray& ray, Interval range, std::uint64_t planes,
                      std::span<const std::uint32_t> primitives, Leaving leaving = {}) const;
+    // Whether primitive i (as visit_near names them) is a sphere of `object`, or a segment of
+    // one's path.
+    bool is_sphere_of(std::uint32_t primitive, const Object* object) const {
+        const Primitive& p = primitives_[primitive];
+        return !is_mesh(p.kind) && objects_[p.object] == object;
+    }
     // Calls visit(i) for each primitive i present at `time` whose ball at that time passes
     // `may_meet` (a conservative test of a Ball), skipping subtrees whose bounding ball fails
     // it; stops, returning false, as soon as visit returns false.

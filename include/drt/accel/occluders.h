@@ -33,8 +33,11 @@ class Occluders {
 
     // Everything may block: always correct.
     Occluders() = default;
-    // What may block segments from `origin` to points of `target` at `time`.
-    Occluders(const Bvh& bvh, const Vec3& origin, const Ball& target, double time);
+    // What may block segments from `origin` to points of `target` at `time`. `target_sphere`:
+    // the target is that object's sphere, and the segments end short of the part of it seen
+    // from `origin`, so that it cannot block them itself.
+    Occluders(const Bvh& bvh, const Vec3& origin, const Ball& target, double time,
+              const Object* target_sphere = nullptr);
 
     Reach reach() const { return reach_; }
     // Whether every ray reaches the light, so that shading needs only the cosines.

@@ -75,8 +75,9 @@ class Integrator final : public PixelIntegrator {
                     const Occluders& occluders, RayCounts& counts) const;
     // One shadow ray towards emitter `emitter` (emitters.h) for the point u of the unit square,
     // in the units of direct_light.
-    Color emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point, const Vec3& origin,
-                      Leaving leaving, const Vec3& geometric, const Vec3& shading, double time,
+    Color emitter_ray(std::size_t emitter, const std::optional<EmitterSample>& drawn,
+                      const Vec3& origin, Leaving leaving, const Vec3& geometric,
+                      const Vec3& shading, double time, const Occluders& occluders,
                       RayCounts& counts) const;
     // A hit's point and its normals facing the ray that arrived (facing_normals).
     struct Facing {

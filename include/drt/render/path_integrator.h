@@ -55,9 +55,10 @@ class PathIntegrator final : public PixelIntegrator {
     Color light_ray(const Light& light, const LightSample& ls, const Vec3& origin, Leaving leaving,
                     const Vec3& geometric, const Vec3& shading, double time,
                     const Occluders& occluders, RayCounts& counts) const;
-    Color emitter_ray(std::size_t emitter, Vec2 u, const Vec3& point, const Vec3& origin,
-                      Leaving leaving, const Vec3& geometric, const Vec3& shading, double time,
-                      double diffuse_pick, RayCounts& counts) const;
+    Color emitter_ray(std::size_t emitter, const std::optional<EmitterSample>& drawn,
+                      const Vec3& origin, Leaving leaving, const Vec3& geometric,
+                      const Vec3& shading, double time, double diffuse_pick,
+                      const Occluders& occluders, RayCounts& counts) const;
     // A direction about `ideal` with angular spread sigma (exactly `ideal` for 0) leaving on the
     // `side` of the surface (+1: the normal's), redrawn as the distributed integrator does.
     Vec3 perturbed(const Vec3& ideal, double sigma, double side, const Vec3& geometric,

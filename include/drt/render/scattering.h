@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "drt/accel/bvh.h"
+#include "drt/accel/occluders.h"
 #include "drt/geometry/object.h"
 #include "drt/render/pixel_integrator.h"
 #include "drt/scene/camera.h"
@@ -44,15 +45,21 @@ struct ReachingEmitter {
     double cosine;
     bool point_light;
 };
-// Both integrators' shadow ray towards an emitter for the point u of the unit square, from
-// `origin` (spawned off `point`), skipping the triangle `leaving`, stopped short of an emitting
-// surface (kShortOfEmitter); nothing when the sample cannot light the point or is blocked.
-// Counts the ray if one is traced.
+// Both integrators' shadow ray towards an emitter along its next-event sample `sample` (none: the
+// sample cannot reach the point), from `origin` (spawned off the shading point), skipping the
+// triangle `leaving`, stopped short of an emitting surface (kShortOfEmitter); nothing when the
+// sample cannot light the point or is blocked, as `occluders` (gathered from `origin` for the
+// emitter's extent, or everything) tell. Counts the ray if one is traced.
 std::optional<ReachingEmitter> reach_emitter(const Emitters& emitters, const Bvh& bvh,
-                                             std::size_t emitter, Vec2 u, const Vec3& point,
+                                             const Occluders& occluders, std::size_t emitter,
+                                             const std::optional<EmitterSample>& sample,
                                              const Vec3& origin, Leaving leaving,
                                              const Vec3& geometric, const Vec3& shading,
                                              double time, RayCounts& counts);
+// What can block the shadow rays of one shading point to emitter i, gathered once for them
+// when `rays` of them are worth it (occluders.h), else everything.
+Occluders emitter_occluders(const Emitters& emitters, const Bvh& bvh, std::size_t emitter, int rays,
+                            const Vec3& origin, double time);
 
 // A direction about `ideal` whose angle from it is Rayleigh-distributed with scale sigma, i.e.
 // a 2-D normal distribution of standard deviation sigma (radians) on the tangent plane.

@@ -80,6 +80,16 @@ class Sampler {
                          : get_2d_in_set(s, dim, static_cast<std::uint32_t>(j),
                                          static_cast<std::uint32_t>(rays));
     }
+    // get_2d_for_ray for rays first .. first + out.size() - 1 of `rays`, at once.
+    void get_2d_for_rays(const PixelSample& s, std::uint32_t dim, int rays, int first,
+                         std::span<Vec2> out) const {
+        if (rays == 1) {
+            out[0] = get_2d(s, dim);
+        } else {
+            get_2d_set(s, dim, static_cast<std::uint32_t>(rays), static_cast<std::uint32_t>(first),
+                       out);
+        }
+    }
     // Points first .. first + out.size() - 1 of that set of k, exactly as get_2d_in_set gives
     // them, at once: a sampler can work out what the points share (the set's key) only once.
     virtual void get_2d_set(const PixelSample& s, std::uint32_t dim, std::uint32_t k,

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <unordered_map>
 #include <vector>
 
@@ -77,11 +78,20 @@ class Emitters {
     // A direction towards emitter i from x at `time`, from a uniform point u of the unit square;
     // nothing when the sample cannot reach x (an edge-on triangle).
     std::optional<EmitterSample> sample(std::size_t i, const Vec3& x, Vec2 u, double time) const;
+    // sample(i, x, u[k], time) for every k, into out[k]: what the samples share (a sphere's
+    // cone) is worked out once.
+    void sample(std::size_t i, const Vec3& x, std::span<const Vec2> u, double time,
+                std::span<std::optional<EmitterSample>> out) const;
     // The density per unit solid angle with which sample(i, x, ·, time) picks the direction
     // from x to `point` on the emitter, whose geometric normal there is `normal`, on its
     // primitive `primitive` (a mesh's triangle: Hit::primitive).
     double pdf(std::size_t i, const Vec3& x, const Vec3& point, const Vec3& normal,
                std::uint32_t primitive, double time) const;
+    // A ball holding every point sample(i, ·, ·, time) aims at (a point light's position alone),
+    // so that what can block shadow rays to it can be gathered once (occluders.h). None for the
+    // environment, at infinity, nor for a mesh: its triangles are one mesh with the scene's
+    // other <Triangle>s, which a gathering would always find.
+    std::optional<Ball> extent(std::size_t i, double time) const;
     // Which emitter an object is, if it is sampled as one.
     std::optional<std::size_t> index_of(const Object* object) const;
     // Which emitter the environment is, if there is one.
