@@ -73,8 +73,8 @@ class Integrator final : public PixelIntegrator {
     Color light_ray(const Light& light, const LightSample& ls, const Vec3& origin, Leaving leaving,
                     const Vec3& geometric, const Vec3& shading, double time,
                     const Occluders& occluders, RayCounts& counts) const;
-    // One shadow ray towards emitter `emitter` (emitters.h) for the point u of the unit square,
-    // in the units of direct_light.
+    // One shadow ray towards emitter `emitter` (emitters.h) along its sample `drawn`, tested
+    // against `occluders`, in the units of direct_light.
     Color emitter_ray(std::size_t emitter, const std::optional<EmitterSample>& drawn,
                       const Vec3& origin, Leaving leaving, const Vec3& geometric,
                       const Vec3& shading, double time, const Occluders& occluders,

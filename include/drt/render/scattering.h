@@ -45,8 +45,8 @@ struct ReachingEmitter {
     double cosine;
     bool point_light;
 };
-// Both integrators' shadow ray towards an emitter along its next-event sample `sample` (none: the
-// sample cannot reach the point), from `origin` (spawned off the shading point), skipping the
+// Both integrators' shadow ray towards an emitter along its next-event sample (none: it cannot
+// reach the point), from `origin` (spawned off the shading point), skipping the
 // triangle `leaving`, stopped short of an emitting surface (kShortOfEmitter); nothing when the
 // sample cannot light the point or is blocked, as `occluders` (gathered from `origin` for the
 // emitter's extent, or everything) tell. Counts the ray if one is traced.
