@@ -293,6 +293,16 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
             throw LimitError(*problem);
         }
     });
+    if (status == kOk && job.leader()) {
+        // Before the render, so that no work is spent (nor a checkpoint lost) on an image with
+        // nowhere to go; a failed write, as it would be after the render (status 1).
+        try {
+            check_replaceable(output);
+        } catch (const FileWriteError& e) {
+            err << "drt: " << e.what() << "\n";
+            status = kFailed;
+        }
+    }
     if (const int agreed = job.agree(status); agreed != kOk) {
         if (status == kOk) err << "drt: " << name << ": failed in another process\n";
         outcome.status = agreed;
@@ -368,6 +378,13 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
     if (!r.complete()) {
         err << "drt: " << name << ": interrupted with " << r.done << " of " << r.tiles
             << " tiles done; wrote " << printable(target.string());
+        if (checkpoint && !r.checkpoint_failure.empty()) {
+            // The rendered tiles are in the partial image, but no run can resume them.
+            err << "\ndrt: " << printable(r.checkpoint_failure)
+                << "\ndrt: the checkpoint could not be written: this render cannot be resumed\n";
+            outcome.status = job.agree(kFailed);
+            return outcome;
+        }
         if (checkpoint) {
             err << " and " << printable(checkpoint->string())
                 << "\ndrt: run the same command again to resume\n";
@@ -428,6 +445,83 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
     }
     outcome.status = job.agree(status);
     return outcome;
+}
+
+// Where one scene's image and checkpoint go: with several scenes (or -o DIR/), each is named
+// after its scene file inside the -o and --checkpoint folders.
+struct SceneFiles {
+    fs::path image;
+    std::optional<fs::path> checkpoint;
+};
+
+SceneFiles files_of(const std::string& scene, const std::string& output,
+                    const std::string& checkpoint, bool batch) {
+    const std::string stem = fs::path(scene).stem().string();
+    SceneFiles f{stem + ".png", std::nullopt};
+    if (!checkpoint.empty()) f.checkpoint = fs::path(checkpoint);
+    if (batch) {
+        if (!output.empty()) f.image = fs::path(output) / f.image;
+        if (f.checkpoint) *f.checkpoint /= stem + ".checkpoint";
+    } else if (!output.empty()) {
+        f.image = output;
+    }
+    return f;
+}
+
+// Whether two paths name one file: the same path once absolute and normal, or, where both
+// exist, the same file by another name (a link).
+bool same_file(const fs::path& a, const fs::path& b) {
+    std::error_code ec;
+    if (fs::exists(a, ec) && fs::exists(b, ec)) {
+        const bool same = fs::equivalent(a, b, ec);
+        if (!ec) return same;
+    }
+    const auto normal = [](const fs::path& p) {
+        std::error_code error;
+        const fs::path canonical = fs::weakly_canonical(fs::absolute(p, error), error);
+        return error ? fs::absolute(p).lexically_normal() : canonical;
+    };
+    return normal(a) == normal(b);
+}
+
+// Two of the files a command writes that are one file, which would destroy each other (a
+// checkpoint is removed once the image is written; a batch's second image replaces the first).
+// A scene given twice writes the same image twice, which destroys nothing.
+std::optional<std::string> clashing_files(const std::vector<std::string>& scenes,
+                                          const std::string& output, const std::string& stats,
+                                          const RenderCommand& job, bool batch) {
+    struct Written {
+        std::string what;  // what writes it, for the message
+        fs::path file;
+        std::string scene;        // whose image or checkpoint it is, if a scene's
+        bool checkpoint = false;  // a scene's checkpoint, not its image
+    };
+    std::vector<Written> files;
+    for (const std::string& scene : scenes) {
+        const SceneFiles f = files_of(scene, output, job.checkpoint, batch);
+        const std::string of = batch ? " of " + printable(scene) : "";
+        files.push_back({std::string(batch || output.empty() ? "the image" : "-o") + of, f.image,
+                         scene, false});
+        if (f.checkpoint) {
+            files.push_back({std::string(batch ? "the checkpoint" : "--checkpoint") + of,
+                             *f.checkpoint, scene, true});
+        }
+    }
+    if (!job.error_image.empty()) files.push_back({"--error-image", job.error_image, "", false});
+    if (!stats.empty() && stats != "-") files.push_back({"--stats", stats, "", false});
+    for (std::size_t i = 0; i < files.size(); ++i) {
+        for (std::size_t j = i + 1; j < files.size(); ++j) {
+            const Written &a = files[i], &b = files[j];
+            if (!same_file(a.file, b.file)) continue;
+            const bool one_scene_twice = !a.scene.empty() && !b.scene.empty() &&
+                                         a.checkpoint == b.checkpoint &&
+                                         same_file(a.scene, b.scene);
+            if (one_scene_twice) continue;
+            return a.what + " and " + b.what + " are one file, " + printable(b.file.string()) +
+                   ": one would destroy the other";
+        }
+    }
+    return std::nullopt;
 }
 
 }  // namespace
@@ -546,6 +640,10 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
         err << "drt: --report needs a batch: -o DIR/\nRun 'drt --help' for usage.\n";
         return kBadInput;
     }
+    if (const auto clash = clashing_files(scenes, output, stats, job, batch)) {
+        err << "drt: " << *clash << "\nRun 'drt --help' for usage.\n";
+        return kBadInput;
+    }
     int made = kOk;
     if (job.leader()) {
         for (const std::string& folder : {batch ? output : "", batch ? job.checkpoint : ""}) {
@@ -564,17 +662,9 @@ int render_command(int argc, const char* const* argv, std::ostream& out, std::os
     job.stop = signals.token();
     std::vector<SceneOutcome> outcomes;
     for (const std::string& scene : scenes) {
-        fs::path target = fs::path(scene).stem().string() + ".png";
-        std::optional<fs::path> checkpoint;
-        if (!job.checkpoint.empty()) checkpoint = job.checkpoint;
-        if (batch) {
-            if (!output.empty()) target = fs::path(output) / target;
-            if (checkpoint) *checkpoint /= fs::path(scene).stem().string() + ".checkpoint";
-        } else if (!output.empty()) {
-            target = output;
-        }
-        outcomes.push_back(render_one(scene, target, checkpoint, job, err));
-        outcomes.back().output = target;
+        const SceneFiles files = files_of(scene, output, job.checkpoint, batch);
+        outcomes.push_back(render_one(scene, files.image, files.checkpoint, job, err));
+        outcomes.back().output = files.image;
         // An interrupt ends the batch: the scenes after it are not started.
         if (outcomes.back().status > kBadInput) break;
     }

@@ -218,6 +218,21 @@ std::vector<unsigned char> encode_checkpoint(const RenderIdentity& id,
     return std::move(w.bytes);
 }
 
+namespace {
+
+[[noreturn]] void fail_another_render(const fs::path& file, const std::string& differs) {
+    fail(file, "checkpoint of another render: made by " + differs +
+                   "; not resumed and nothing written (delete it or name another "
+                   "--checkpoint file)");
+}
+
+std::string another_size(const RenderIdentity& id) {
+    return "another image size (" + std::to_string(id.width) + "x" + std::to_string(id.height) +
+           ")";
+}
+
+}  // namespace
+
 Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<const Tile> grid,
                              const fs::path& file, DiffuseCount expected) {
     if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic - 1) != 0) {
@@ -255,7 +270,14 @@ Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<con
     id.width = static_cast<int>(r.u32());
     id.height = static_cast<int>(r.u32());
     id.tiles = r.u64();
-    if (id.tiles != grid.size()) fail(file, "checkpoint of another image size");
+    // The tiles are decoded against this image's grid: a checkpoint of another size is refused
+    // as such first, even where its grid has as many tiles.
+    int grid_width = 0, grid_height = 0;
+    for (const Tile& t : grid)
+        grid_width = std::max(grid_width, t.x1), grid_height = std::max(grid_height, t.y1);
+    if (id.tiles != grid.size() || id.width != grid_width || id.height != grid_height) {
+        fail_another_render(file, another_size(id));
+    }
     const std::uint64_t count = r.u64();
     if (count > grid.size()) fail(file, "damaged checkpoint (more tiles than the image has)");
     if (format == kAovFormatWithoutDiffuse || format == kAovFormatWithDiffuse) {
@@ -289,17 +311,12 @@ std::optional<Checkpoint> read_checkpoint(const fs::path& file, const RenderIden
     } else if (got.diffuse != expected.diffuse) {
         differs = "the other integrator (its format counts diffuse rays differently)";
     } else if (got.width != expected.width || got.height != expected.height) {
-        differs = "another image size (" + std::to_string(got.width) + "x" +
-                  std::to_string(got.height) + ")";
+        differs = another_size(got);
     } else if (got.options != expected.options || got.tiles != expected.tiles ||
                got.aov_channels != expected.aov_channels) {
         differs = "other options (samples, seed, sampler or another setting differs)";
     }
-    if (!differs.empty()) {
-        fail(file, "checkpoint of another render: made by " + differs +
-                       "; not resumed and nothing written (delete it or name another "
-                       "--checkpoint file)");
-    }
+    if (!differs.empty()) fail_another_render(file, differs);
     return c;
 }
 

@@ -167,7 +167,13 @@ RenderJobResult run_job(const RenderContext& context, const RenderRequest& asked
     out.done = image->tiles_done();
     RenderStats& stats = out.render.stats;
     add_share(stats, share, finished, options.mpi);
-    if (kept && !out.complete()) kept->write();
+    if (kept && !out.complete()) {
+        try {
+            kept->write();
+        } catch (const CheckpointError& e) {
+            out.checkpoint_failure = e.what();
+        }
+    }
     stats.seconds = seconds_between(start, Clock::now());
     stats.setup_seconds = stats.seconds - seconds_between(tiles_start, finished);
     return out;

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <string>
@@ -202,6 +203,58 @@ TEST_F(TempDir, ACheckpointOfAnotherRenderIsRefusedSayingWhatDiffers) {
                   ": checkpoint of another render: made by other options (samples, seed, sampler "
                   "or another setting differs); not resumed and nothing written (delete it or "
                   "name another --checkpoint file)");
+}
+
+// A checkpoint of another image size whose grid has as many tiles (40 x 24 and 24 x 40, six
+// tiles each) is refused as one of another size, before its tiles are read against this grid.
+TEST_F(TempDir, ACheckpointOfAnotherSizeWithAsManyTilesIsRefusedAsSuch) {
+    const std::vector<Tile> wide = tile_grid(40, 24), tall = tile_grid(24, 40);
+    ASSERT_EQ(wide.size(), tall.size());
+    RenderIdentity made = identity_of(wide);
+    made.width = 40;
+    made.height = 24;
+    RenderIdentity wanted = made;
+    wanted.width = 24;
+    wanted.height = 40;
+    const fs::path file = dir_ / "c.ckpt";
+    replace_file(file, encode_checkpoint(made, std::vector{some_tile(wide[1], 1.0f)}));
+    try {
+        read_checkpoint(file, wanted, tall);
+        ADD_FAILURE() << "accepted";
+    } catch (const CheckpointError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  file.string() +
+                      ": checkpoint of another render: made by another image size (40x24); not "
+                      "resumed and nothing written (delete it or name another --checkpoint file)");
+    }
+    EXPECT_EQ(read_checkpoint(file, made, wide)->tiles.size(), 1u);
+}
+
+// A stopped render whose checkpoint cannot be written (its folder gone) still returns the tiles
+// it rendered, saying why nothing was kept, so that the caller can write the partial image.
+TEST_F(TempDir, AStoppedRenderWhoseCheckpointCannotBeWrittenStillReturnsItsImage) {
+    const Scene scene = small_scene();
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
+    RenderJobOptions options;
+    options.threads = 1;
+    fs::create_directory(dir_ / "gone");
+    options.checkpoint = dir_ / "gone" / "c.ckpt";
+    options.scene_files = {kEffects};
+    options.stop_after_tiles = 2;
+    options.on_progress = [&](double) { fs::remove_all(dir_ / "gone"); };
+    const RenderJobResult r = run_render_job(scene, request, options);
+    EXPECT_FALSE(r.complete());
+    EXPECT_EQ(r.done, 2u);
+    EXPECT_NE(r.checkpoint_failure.find("c.ckpt: cannot create file"), std::string::npos)
+        << r.checkpoint_failure;
+    EXPECT_EQ(r.render.image.width, scene.settings.width);
+    EXPECT_GT(*std::max_element(r.render.image.rgb.begin(), r.render.image.rgb.end()), 0.0f);
+    // With its folder there, the same render keeps its checkpoint and says nothing.
+    options.on_progress = nullptr;
+    fs::create_directory(dir_ / "gone");
+    const RenderJobResult kept = run_render_job(scene, request, options);
+    EXPECT_TRUE(kept.checkpoint_failure.empty()) << kept.checkpoint_failure;
+    EXPECT_TRUE(fs::exists(*options.checkpoint));
 }
 
 // A distributed render writes format 4, whose tiles have no diffuse count; a path render format 5,
@@ -542,6 +595,42 @@ TEST_F(CheckpointCli, SigintAndSigtermStopSaveAndExit130And143ThenTheRerunFinish
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(read_bytes(dir_ / "out.pfm"), read_bytes(dir_ / "plain.pfm"));
     EXPECT_FALSE(fs::exists(dir_ / "c.ckpt"));
+}
+
+// Files of one command that are one file are refused before anything is rendered or written:
+// the image and the checkpoint (removed once the image is written, which would remove the image),
+// the error image or the statistics, and two scenes of a batch with the same name (status 2). An
+// output with nowhere to go fails before the render (status 1), so that no checkpoint is lost.
+TEST_F(CheckpointCli, FilesThatAreOneFileAndAnOutputWithNowhereToGoFailBeforeRendering) {
+    replace_file(dir_ / "same.pfm", std::string("kept"));
+    Outcome r = run(command("same.pfm", {"--checkpoint", "same.pfm"}));
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.err,
+              "drt: -o and --checkpoint are one file, same.pfm: one would destroy the other\n"
+              "Run 'drt --help' for usage.\n");
+    EXPECT_EQ(read_bytes(dir_ / "same.pfm"), "kept");
+    r = run(command("out.pfm", {"--error-image", "err.pfm", "--checkpoint", "sub/../err.pfm"}));
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("--checkpoint and --error-image are one file"), std::string::npos)
+        << r.err;
+    r = run(command("out.pfm", {"--stats", "./out.pfm"}));
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("-o and --stats are one file"), std::string::npos) << r.err;
+    fs::create_directories(dir_ / "a");
+    fs::create_directories(dir_ / "b");
+    fs::copy_file(kEffects, dir_ / "a/x.xml");
+    fs::copy_file(kEffects, dir_ / "b/x.xml");
+    r = run({"a/x.xml", "b/x.xml", "--width", "8", "--height", "6", "--spp", "1", "-o", "out/"});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("the image of a/x.xml and the image of b/x.xml are one file"),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "out"));
+    r = run(command("nowhere/out.pfm", {"--checkpoint", "c.ckpt"}));
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(r.err, "drt: nowhere/out.pfm: cannot create file: No such file or directory\n");
+    EXPECT_FALSE(fs::exists(dir_ / "c.ckpt"));
+    EXPECT_EQ(run(command("out.pfm", {"--checkpoint", "c.ckpt"})).status, 0);
 }
 
 }  // namespace

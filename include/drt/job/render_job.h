@@ -10,6 +10,7 @@
 #include <functional>
 #include <optional>
 #include <stop_token>
+#include <string>
 #include <vector>
 
 #include "drt/job/mpi_work.h"
@@ -45,13 +46,16 @@ struct RenderJobResult {
     std::size_t tiles = 0;    // in the image
     std::size_t resumed = 0;  // taken from the checkpoint
     std::size_t done = 0;     // finished, resumed ones included
+    // Why the checkpoint of a stopped render could not be written (empty: it was, or there is
+    // none): the image is still returned, so that the caller can keep what was rendered.
+    std::string checkpoint_failure;
     bool complete() const { return done == tiles; }
 };
 
 // Sets `scene` up and renders `request` (collective under MPI). Throws CheckpointError (on every
 // process) when the checkpoint cannot be used; when stopped, the checkpoint has been written
-// before this returns. The caller writes the image, and removes the checkpoint once the image
-// is safely written.
+// before this returns, or checkpoint_failure says why not. The caller writes the image, and removes
+// the checkpoint once the image is safely written.
 RenderJobResult run_render_job(const Scene& scene, const RenderRequest& request,
                                const RenderJobOptions& options);
 
