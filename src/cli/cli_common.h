@@ -103,8 +103,11 @@ struct GoalForecast {
     std::optional<Prediction> slow;
 };
 
-GoalForecast forecast(const Scene& scene, double target, int threads);
+// The goal render's pilots, and what they predict for a target error within `max_samples`.
+GoalForecast forecast(const Scene& scene, double target, int threads, int max_samples);
 std::string forecast_text(const GoalForecast& f, double target);
+// forecast_text, or why no forecast can be made (caustics, which refuse a goal).
+std::string goal_forecast(const Scene& scene, double target, int threads, int max_samples);
 
 // The commands, each in a file of its own. argv as CLI11 parses it: argv[0] names the program or
 // the command, the options follow.

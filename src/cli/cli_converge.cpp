@@ -14,6 +14,7 @@
 #include "drt/render/error_estimate.h"
 #include "drt/scene/render_limits.h"
 #include "drt/scene/scene_loader.h"
+#include "drt/util/atomic_file.h"
 #include "drt/util/limits.h"
 #include "drt/util/text.h"
 
@@ -39,15 +40,18 @@ struct ConvergeFlags {
             ->check(finite_positive());
         app.add_option("--spp", counts_text,
                        "Comma-separated sample counts (default 1,4,16,64,256)");
-        app.add_option("--reference", reference_path,
-                       "Reference image (.pfm or .exr) to measure against; default: render one");
+        CLI::Option* reference = app.add_option(
+            "--reference", reference_path,
+            "Reference image (.pfm or .exr) to measure against; default: render one");
         app.add_option("--reference-spp", reference_spp,
                        "Samples of the rendered reference (default 16 x the largest count, at "
                        "most " +
                            std::to_string(kMaxSamples) + ")")
-            ->check(integer_in(1, kMaxSamples));
+            ->check(integer_in(1, kMaxSamples))
+            ->excludes(reference);
         app.add_option("--save-reference", save_reference,
-                       "Write the rendered reference to FILE (.pfm or .exr)");
+                       "Write the rendered reference to FILE (.pfm or .exr)")
+            ->excludes(reference);
         app.add_option("--csv", csv,
                        "Write spp,seconds,rmse,relmse,mean_spp,cpu_seconds,fitted,"
                        "estimated_rmse,estimated_relmse rows to FILE");
@@ -156,7 +160,7 @@ void converge(const ConvergeFlags& flags, const std::vector<int>& counts, std::o
     }
     out << "\n";
     if (flags.target) {
-        out << forecast_text(forecast(scene, *flags.target, flags.threads), *flags.target);
+        out << goal_forecast(scene, *flags.target, flags.threads, kMaxSamples);
     }
     const Image reference = reference_image(scene, flags, counts, options, out);
     print_header(out);
@@ -190,6 +194,10 @@ int converge_command(int argc, const char* const* argv, std::ostream& out, std::
                 throw CLI::ValidationError(f +
                                            ": the reference must be a linear .pfm or .exr image");
             }
+        }
+        // Before anything renders, so that no render is spent on a file with nowhere to go.
+        for (const std::string& f : {flags.save_reference, flags.csv}) {
+            if (!f.empty()) check_replaceable(f);
         }
     } catch (const CLI::CallForHelp&) {
         out << app.help();

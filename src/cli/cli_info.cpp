@@ -16,10 +16,10 @@
 
 namespace drt::cli {
 
-GoalForecast forecast(const Scene& scene, double target, int threads) {
+GoalForecast forecast(const Scene& scene, double target, int threads, int max_samples) {
     RenderGoal goal;
     goal.target_error = target;
-    goal.max_samples = kMaxSamples;
+    goal.max_samples = max_samples;
     goal.stop_before_final = true;
     RenderJobOptions options;
     options.threads = threads;
@@ -29,14 +29,14 @@ GoalForecast forecast(const Scene& scene, double target, int threads) {
     if (f.rounds.empty()) return f;
     double seconds = 0;
     for (const GoalRound& r : f.rounds) seconds += r.seconds;
-    const NextRound last = next_round(f.rounds, target, kMaxSamples);
+    const NextRound last = next_round(f.rounds, target, max_samples);
     if (last.spp == 0) {
         f.total = Prediction{before_final.samples, seconds};
     } else if (last.final) {
         f.final_round = last.spp;
         f.total = Prediction{before_final.samples + last.spp,
                              seconds + predicted_seconds(f.rounds, last.spp)};
-        if (const auto slow = predict(f.rounds, target, kMaxSamples, -0.5);
+        if (const auto slow = predict(f.rounds, target, max_samples, -0.5);
             slow && slow->spp > last.spp) {
             f.slow = Prediction{before_final.samples + slow->spp, seconds + slow->seconds};
         }
@@ -75,6 +75,20 @@ std::string forecast_text(const GoalForecast& f, double target) {
     return text.str() + "\n";
 }
 
+std::string goal_forecast(const Scene& scene, double target, int threads, int max_samples) {
+    if (plan_render(scene).effects.caustics) {
+        return "no forecast for --target-error: caustics from photon maps are biased at every "
+               "finite gather radius, and a render refuses the goal (docs/accuracy.md)\n";
+    }
+    const GoalForecast f = forecast(scene, target, threads, max_samples);
+    std::string text = forecast_text(f, target);
+    if (f.total && f.total->spp >= max_samples) {
+        text += "(--spp " + std::to_string(max_samples) +
+                " caps the rounds: the target may not be reached)\n";
+    }
+    return text;
+}
+
 int info_command(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
     CLI::App app{"Show what a scene contains and which effects it calls for", "drt info"};
     std::string scene_path;
@@ -96,11 +110,9 @@ int info_command(int argc, const char* const* argv, std::ostream& out, std::ostr
         overrides.apply(loaded.scene.settings);
         const RenderPlan plan = plan_render(loaded.scene);
         out << describe(loaded.scene, plan);
-        if (target && plan.effects.caustics) {
-            out << "no forecast for --target-error: caustics from photon maps are biased at every "
-                   "finite gather radius, and a render refuses the goal (docs/accuracy.md)\n";
-        } else if (target) {
-            out << forecast_text(forecast(loaded.scene, *target, threads), *target);
+        if (target) {
+            out << goal_forecast(loaded.scene, *target, threads,
+                                 overrides.spp.value_or(kMaxSamples));
         }
     } catch (const SceneError& e) {
         return report_failure(e, "drt info", printable(scene_path), err);

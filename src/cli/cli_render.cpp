@@ -216,7 +216,9 @@ std::string goal_summary(const std::string& name, const GoalResult& p, const Goa
          << (p.error ? short_number(*p.error) : std::string("n/a"));
     if (goal.target_error) {
         line << " (target " << short_number(*goal.target_error)
-             << (p.target_met ? " met)" : " not met)");
+             << (p.target_met ? " met)"
+                 : p.error    ? " not met)"
+                              : " not met: without an estimate no more samples can be judged)");
     }
     if (goal.time_limit) {
         line << "; " << std::fixed << std::setprecision(2) << seconds << " s of the "

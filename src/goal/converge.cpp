@@ -113,9 +113,16 @@ Convergence measure_convergence(const Scene& scene, const std::vector<int>& spps
 }
 
 std::optional<Reach> measured_reach(const Convergence& c, double target) {
-    const ConvergencePoint* before = nullptr;
+    // The counts as listed may come in any order; the reach is along growing counts.
+    std::vector<const ConvergencePoint*> fitted;
     for (const ConvergencePoint& p : c.points) {
-        if (!p.fitted) continue;
+        if (p.fitted) fitted.push_back(&p);
+    }
+    std::stable_sort(fitted.begin(), fitted.end(),
+                     [](const auto* a, const auto* b) { return a->spp < b->spp; });
+    const ConvergencePoint* before = nullptr;
+    for (const ConvergencePoint* point : fitted) {
+        const ConvergencePoint& p = *point;
         if (p.rmse <= target) {
             if (!before || before->rmse <= 0 || p.rmse <= 0) return Reach{double(p.spp), p.seconds};
             // Log-linear in both: t in [0, 1] from `before` to `p`.

@@ -40,6 +40,9 @@ constexpr double kSmallRoundSlope = -0.75;
 // round's, and a steep slope errs on the short side, which a top-up makes up cheaply.
 constexpr double kPilotSpareShare = 0.95;
 constexpr double kPilotSlope = -0.8;
+// A time limit at least this long (seconds, some 32 years) sets no alarm: the steady clock's
+// nanoseconds would overflow not far past it, putting the alarm in the past.
+constexpr double kLongestAlarm = 1e9;
 // Of the time left, what a round may be predicted to take: the rest absorbs the prediction's
 // error.
 constexpr double kTimeShare = 0.9;
@@ -440,6 +443,11 @@ NextRound next_round(const std::vector<GoalRound>& rounds, double target, int ma
     const int total = total_samples(rounds);
     const int left = max_samples - total;
     if ((last.combined && *last.combined <= target) || left < kMinRound) return {};
+    // An image whose rounds give no estimate (too few pixels to calibrate, radiance past the
+    // floats) cannot be judged against the target: more samples would only be guesses.
+    const bool image = std::any_of(rounds.begin(), rounds.end(),
+                                   [](const GoalRound& r) { return r.full() || r.top_up(); });
+    if (image && !last.combined) return {};
     // After a round meant as the last that missed, no slope steeper than -1/2: the errors' curves
     // flatten with samples (a pattern's gain over independent samples shrinks), so the slope
     // that led there was too steep.
@@ -544,7 +552,7 @@ class GoalRender {
         std::stop_source stopper;
         const std::stop_callback relay(options_.stop, [&] { stopper.request_stop(); });
         std::optional<Alarm> alarm;
-        if (goal_.time_limit && leader_ && image_rounds_ > 0) {
+        if (goal_.time_limit && *goal_.time_limit < kLongestAlarm && leader_ && image_rounds_ > 0) {
             alarm.emplace(goal_.start + std::chrono::duration_cast<Clock::duration>(
                                             std::chrono::duration<double>(*goal_.time_limit)),
                           stopper);

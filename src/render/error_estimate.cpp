@@ -141,8 +141,9 @@ std::vector<double> calibration_odds(const Image& spread, double share) {
         largest_around(own, spread.width, spread.height, Around::kWithSelf);
     double total = 0;
     for (const double s : spreads) total += s;
-    std::vector<double> odds(pixels, share);
-    if (!(total > 0) || !std::isfinite(total)) return odds;
+    std::vector<double> odds(pixels, std::min(share, 1.0));
+    // A small image is rendered twice whole: odds following the spread would drop some pixels.
+    if (share >= 1 || !(total > 0) || !std::isfinite(total)) return odds;
     const double mean = total / double(pixels);
     for (std::size_t i = 0; i < pixels; ++i) odds[i] = pick_odds(share, 1.0, spreads[i], mean);
     return odds;

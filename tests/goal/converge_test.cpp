@@ -233,6 +233,20 @@ TEST(ConvergeCli, RefusesBadInput) {
     EXPECT_EQ(r.status, 2);
     r = run({"converge", "/nonexistent.xml"});
     EXPECT_EQ(r.status, 2);
+    // Files with nowhere to go, before anything renders; a reference given, and one to render.
+    r = run({"converge", scene, "--csv", "/nonexistent/c.csv", "--scale", "0.05"});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.out, "");
+    EXPECT_NE(r.err.find("/nonexistent/c.csv: cannot create file"), std::string::npos) << r.err;
+    r = run({"converge", scene, "--save-reference", "/nonexistent/r.pfm", "--scale", "0.05"});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.out, "");
+    r = run({"converge", scene, "--reference", "r.pfm", "--reference-spp", "3"});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("--reference excludes --reference-spp"), std::string::npos) << r.err;
+    r = run({"converge", scene, "--reference", "r.pfm", "--save-reference", "s.pfm"});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("--reference excludes --save-reference"), std::string::npos) << r.err;
 }
 
 TEST(Converge, MeasuredReachInterpolatesLogLogBetweenTheCountsAroundTheTarget) {
@@ -255,6 +269,10 @@ TEST(Converge, MeasuredReachInterpolatesLogLogBetweenTheCountsAroundTheTarget) {
     EXPECT_EQ(first->spp, 4);
     EXPECT_EQ(first->seconds, 1);
     EXPECT_FALSE(measured_reach(c, 0.001));
+    // The counts listed largest first: the same reach.
+    std::reverse(c.points.begin(), c.points.end());
+    EXPECT_NEAR(measured_reach(c, 0.01 * std::sqrt(2.0))->spp, 32, 1e-9);
+    EXPECT_EQ(measured_reach(c, 0.05)->spp, 4);
 }
 
 // Path tracing is unbiased: its error against a converged reference falls as N^-1/2 for

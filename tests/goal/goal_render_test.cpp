@@ -164,10 +164,17 @@ TEST(NextRound, APilotATwelfthOfAPredictionFurtherAway) {
     // A twelfth that is less than 4 times the last round is raised to 4 times: 8 * 0.08 /
     // wanted(0.004, 0.08) = 163.3, a twelfth 14, raised to 32.
     EXPECT_EQ(next_round({{8, 1.0, 0.08, 0.08}}, 0.004, 65536).spp, 32);
-    // Without an estimate, a pilot 4 times the last.
-    const NextRound blind = next_round({{8, 1, std::nullopt, std::nullopt}}, 0.01, 65536);
+    // A pilot without an estimate: another 4 times its count.
+    GoalRound pilot{8, 1, std::nullopt, std::nullopt};
+    pilot.kind = RoundKind::kPilot;
+    pilot.pixel_block = 4;
+    const NextRound blind = next_round({pilot}, 0.01, 65536);
     EXPECT_EQ(blind.spp, 32);
     EXPECT_FALSE(blind.final);
+    // A full round without one (too few pixels to calibrate, radiance past the floats): more
+    // samples cannot be judged against the target, so the render ends there.
+    EXPECT_EQ(next_round({{8, 1, std::nullopt, std::nullopt}}, 0.01, 65536).spp, 0);
+    EXPECT_EQ(next_round({pilot, {32, 1, std::nullopt, std::nullopt}}, 0.01, 65536).spp, 0);
 }
 
 TEST(NextRound, AtLeastATenthOfTheSamplesSoFarAndTwo) {
@@ -279,6 +286,23 @@ TEST_F(GoalCli, BadGoalsExitTwoWithTheReasonAndWriteNothing) {
     EXPECT_FALSE(fs::exists(dir_ / "out.pfm"));
     EXPECT_FALSE(fs::exists(dir_ / "s.json"));
     EXPECT_FALSE(fs::exists(dir_ / "c.ckpt"));
+}
+
+// An image without an estimate (16 pixels, fewer than the 24 a calibration needs) stops after
+// its first round instead of growing rounds to --spp, which no estimate could judge; a time
+// limit past the steady clock's range is no limit rather than one already past.
+TEST_F(GoalCli, NoEstimateEndsTheRoundsAndAnEndlessTimeLimitIsNoLimit) {
+    Outcome r = run({"scene.xml", "--width", "4", "--height", "4", "--target-error", "0.001",
+                     "--spp", "4096", "-o", "tiny.pfm"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find(": 8 spp after rounds of 8 spp; estimated rmse n/a (target 0.001 not "
+                         "met: without an estimate no more samples can be judged)"),
+              std::string::npos)
+        << r.err;
+    r = run({"scene.xml", "--width", "8", "--height", "6", "--time-limit", "1e10", "--spp", "40",
+             "-o", "long.pfm"});
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(reached(r.err), 40) << r.err;
 }
 
 TEST_F(GoalCli, SppIsTheMaximumOfAllRoundsTogether) {

@@ -223,6 +223,9 @@ TEST(CalibrationOdds, AQuarterSharedAndTheRestByTheLargestSpreadAround) {
     for (const int i : {2, 3, 6, 7, 8, 9, 10, 11}) EXPECT_DOUBLE_EQ(near[i], f * 0.25) << i;
     // No spread anywhere: the same odds everywhere.
     EXPECT_EQ(calibration_odds(Image(2, 2), f), std::vector<double>(4, f));
+    // A small image (a share of 1) is rendered twice whole, whatever its spread.
+    EXPECT_EQ(calibration_odds(spread, 1.0), std::vector<double>(5, 1.0));
+    EXPECT_EQ(calibration_odds(corner, 1.0), std::vector<double>(12, 1.0));
     // 8 % of an image, but at least 512 pixels, or all of them.
     EXPECT_EQ(calibration_share(10000), kCalibrationShare);
     EXPECT_EQ(calibration_share(1024), 0.5);
