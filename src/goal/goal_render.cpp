@@ -501,6 +501,7 @@ class GoalRender {
         RoundPlan round = first_round();
         while (round.spp > 0) {
             RenderJobResult job = render(round);
+            if (leader_) traced_ += job.render.stats.rays;
             NextPlan next;
             if (!leader_) {
                 if (round.kind != RoundKind::kPilot) out_.job = std::move(job);
@@ -513,6 +514,8 @@ class GoalRender {
             }
             round = share(std::move(next), round);
         }
+        // Every ray traced, pilots and dropped rounds included, as a render's --stats counts.
+        if (leader_) out_.job.render.stats.rays = traced_;
         return std::move(out_);
     }
 
@@ -703,6 +706,7 @@ class GoalRender {
     // Rounds done but the pilots, top-ups included: the next one's round_seed.
     std::size_t image_rounds_ = 0;
     std::optional<TopUp> top_up_;  // the round in hand's, when a top-up (leader)
+    RayCounts traced_;             // by every round so far (leader)
 };
 
 }  // namespace

@@ -290,7 +290,8 @@ TEST_F(GoalCli, BadGoalsExitTwoWithTheReasonAndWriteNothing) {
 
 // An image without an estimate (16 pixels, fewer than the 24 a calibration needs) stops after
 // its first round instead of growing rounds to --spp, which no estimate could judge; a time
-// limit past the steady clock's range is no limit rather than one already past.
+// limit past the steady clock's range is no limit rather than one already past, and --stats
+// counts the rays of all its rounds.
 TEST_F(GoalCli, NoEstimateEndsTheRoundsAndAnEndlessTimeLimitIsNoLimit) {
     Outcome r = run({"scene.xml", "--width", "4", "--height", "4", "--target-error", "0.001",
                      "--spp", "4096", "-o", "tiny.pfm"});
@@ -300,9 +301,14 @@ TEST_F(GoalCli, NoEstimateEndsTheRoundsAndAnEndlessTimeLimitIsNoLimit) {
               std::string::npos)
         << r.err;
     r = run({"scene.xml", "--width", "8", "--height", "6", "--time-limit", "1e10", "--spp", "40",
-             "-o", "long.pfm"});
+             "-o", "long.pfm", "--stats", "long.json"});
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(reached(r.err), 40) << r.err;
+    // Its rays are those of every round, the replaced one of 8 spp included.
+    EXPECT_NE(bytes("long.json").find("\"rounds\": [{\"spp\": 8, "), std::string::npos);
+    EXPECT_NE(bytes("long.json").find("\"camera\": " + std::to_string((8 + 40) * 8 * 6) + ","),
+              std::string::npos)
+        << bytes("long.json");
 }
 
 TEST_F(GoalCli, SppIsTheMaximumOfAllRoundsTogether) {
