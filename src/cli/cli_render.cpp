@@ -231,11 +231,12 @@ std::string goal_summary(const std::string& name, const GoalResult& p, const Goa
         line << "\ndrt: " << name << ": --spp " << p.samples
              << " renders the same image (bit-identical) without a goal\n";
     } else {
+        // Stopped, the same command would go on to more rounds: only their start is the same.
         line << "\ndrt: " << name
              << ": the rounds' images combined (weighted by 1 / estimated variance); the same "
                 "command renders the same image "
-             << (goal.time_limit ? "where it completes the same rounds\n"
-                                 : "(bit-identical) every run\n");
+             << (goal.time_limit || p.stopped ? "where it completes the same rounds\n"
+                                              : "(bit-identical) every run\n");
     }
     return line.str();
 }
