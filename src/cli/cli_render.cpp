@@ -292,7 +292,8 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
         }
         RenderSettings largest = loaded->scene.settings;
         if (job.goal.wanted() && !job.overrides.spp) largest.samples = kMaxSamples;
-        if (const auto problem = render_limit_problem(largest, job.threads)) {
+        if (const auto problem = render_limit_problem(
+                largest, job.threads, static_cast<int>(aov_channel_count(job.aovs)))) {
             throw LimitError(*problem);
         }
     });

@@ -22,15 +22,18 @@ std::optional<std::string> photon_budget_problem(const RenderSettings& s) {
            " MiB share of the budget: lower Samples or the Photons Count";
 }
 
-std::uint64_t estimated_render_bytes(const RenderSettings& settings, int threads) {
+std::uint64_t estimated_render_bytes(const RenderSettings& settings, int threads,
+                                     int aov_channels) {
     const std::uint64_t pixels =
         std::uint64_t(std::max(settings.width, 0)) * std::uint64_t(std::max(settings.height, 0));
     const std::uint64_t samples = std::uint64_t(std::max(settings.samples, 0));
-    return pixels * kBytesPerPixel +
+    return pixels *
+               (kBytesPerPixel + kBytesPerAovChannel * std::uint64_t(std::max(aov_channels, 0))) +
            std::uint64_t(std::max(threads, 1)) * samples * kBytesPerSample + photon_bytes(settings);
 }
 
-std::optional<std::string> render_limit_problem(const RenderSettings& s, int threads) {
+std::optional<std::string> render_limit_problem(const RenderSettings& s, int threads,
+                                                int aov_channels) {
     const auto over = [](const std::string& what, std::uint64_t value, std::uint64_t limit) {
         return what + " " + std::to_string(value) + " exceeds the limit of " +
                std::to_string(limit);
@@ -53,10 +56,16 @@ std::optional<std::string> render_limit_problem(const RenderSettings& s, int thr
     if (s.max_depth > kMaxDepthLimit) return over("max depth", s.max_depth, kMaxDepthLimit);
     if (auto photons = photon_budget_problem(s)) return photons;
     const int workers = worker_threads(threads);
-    const std::uint64_t bytes = estimated_render_bytes(s, workers);
+    const std::uint64_t bytes = estimated_render_bytes(s, workers, aov_channels);
     if (bytes > kMemoryBudget) {
+        std::string per_pixel = std::to_string(kBytesPerPixel);
+        if (aov_channels > 0) {
+            per_pixel.insert(0, "(");
+            per_pixel += " + " + std::to_string(aov_channels) + " AOV channels x " +
+                         std::to_string(kBytesPerAovChannel) + ")";
+        }
         return "the render needs an estimated " + std::to_string(bytes >> 20) + " MiB (" +
-               std::to_string(pixels) + " pixels x " + std::to_string(kBytesPerPixel) + " B + " +
+               std::to_string(pixels) + " pixels x " + per_pixel + " B + " +
                std::to_string(workers) + " threads x " + std::to_string(s.samples) + " samples x " +
                std::to_string(kBytesPerSample) + " B), more than the " +
                std::to_string(kMemoryBudget >> 20) + " MiB budget";

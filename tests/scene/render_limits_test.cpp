@@ -28,6 +28,20 @@ TEST(Limits, EstimateCountsPixelsAndEachThreadsSamples) {
     EXPECT_EQ(estimated_render_bytes(s, 3), 24u * 16 * 28 + 3u * 4 * 576);
 }
 
+// AOV channels (--aov) add to every pixel's memory, and so to what a checkpoint of the image
+// holds: the largest image with all seven is refused, naming them; with none it renders.
+TEST(Limits, AovChannelsCountInEveryPixel) {
+    RenderSettings s = small();
+    EXPECT_EQ(estimated_render_bytes(s, 3, 7), 24u * 16 * (28 + 7 * 8) + 3u * 4 * 576);
+    s.width = 16384, s.height = 8192, s.samples = 1;
+    EXPECT_FALSE(render_limit_problem(s, 2, 0));
+    EXPECT_EQ(render_limit_problem(s, 2, 7).value_or(""),
+              "the render needs an estimated 10752 MiB (134217728 pixels x (28 + 7 AOV channels x "
+              "8) B + 2 threads x 1 samples x 576 B), more than the 4096 MiB budget");
+    s.height = 4096;  // half the pixels: with one channel within the budget
+    EXPECT_FALSE(render_limit_problem(s, 2, 1));
+}
+
 TEST(Limits, ImageSideAtAndPastTheLimit) {
     RenderSettings s = small();
     s.width = 65536, s.height = 1;

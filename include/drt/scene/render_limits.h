@@ -19,11 +19,15 @@ std::uint64_t photon_bytes(const RenderSettings& settings);
 // settings the command line leaves.
 std::optional<std::string> photon_budget_problem(const RenderSettings& settings);
 
-// The memory a render of these settings on `threads` worker threads needs at its peak.
-std::uint64_t estimated_render_bytes(const RenderSettings& settings, int threads);
+// The memory a render of these settings on `threads` worker threads needs at its peak, with
+// `aov_channels` AOV values a pixel (--aov) besides its colour.
+std::uint64_t estimated_render_bytes(const RenderSettings& settings, int threads,
+                                     int aov_channels = 0);
 
 // Why these settings cannot be rendered on `threads` threads (0 = all cores), or nothing: a size
-// or count past its limit, or an estimate past kMemoryBudget. One line, naming the limit.
-std::optional<std::string> render_limit_problem(const RenderSettings& settings, int threads);
+// or count past its limit, or an estimate past kMemoryBudget. One line, naming the limit. The
+// budget also bounds the checkpoint a render writes, which holds what its pixels hold.
+std::optional<std::string> render_limit_problem(const RenderSettings& settings, int threads,
+                                                int aov_channels = 0);
 
 }  // namespace drt

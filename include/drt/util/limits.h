@@ -17,6 +17,9 @@ inline constexpr std::uint64_t kMemoryBudget = std::uint64_t{4} << 30;  // 4 GiB
 // Memory per pixel at the peak, the final write: the float image (12 bytes), adaptive
 // sampling's per-pixel counts (4) and the encoded file in memory (at most 12, a .pfm).
 inline constexpr std::uint64_t kBytesPerPixel = 28;
+// Memory per AOV value of a pixel (--aov) at the same peak: the float (4 bytes) and its place in
+// the encoded .exr (at most 4). A checkpoint holds the float, so it too stays within the budget.
+inline constexpr std::uint64_t kBytesPerAovChannel = 8;
 // Memory per camera sample of a pixel, in every worker thread: its colour, film and lens points
 // (24 + 16 + 16), adaptive sampling's luminance (8), and the remembered glossy points of a run
 // (up to 32 dimensions of 16 bytes).
