@@ -20,6 +20,17 @@ TEST(Text, PrintableEscapesWhatATerminalWouldActOn) {
                         "2J"),
               "\\xc2\\x9b2J");
     EXPECT_EQ(printable("\xc2\xa0"), "\xc2\xa0");
+    // A C1 control's C2 escaped, then the C1 byte left alone is no character either.
+    EXPECT_EQ(printable("\xc2\x85"), "\\xc2\\x85");
+    // Bytes of no UTF-8 character (a raw CSI, a cut sequence, an overlong form, a surrogate),
+    // each escaped; the well-formed characters around them kept.
+    EXPECT_EQ(printable("a\x9b"
+                        "2J"),
+              "a\\x9b2J");
+    EXPECT_EQ(printable("\xe2\x9c"), "\\xe2\\x9c");
+    EXPECT_EQ(printable("\xc0\xaf"), "\\xc0\\xaf");
+    EXPECT_EQ(printable("\xed\xa0\x80"), "\\xed\\xa0\\x80");
+    EXPECT_EQ(printable("\xf0\x9f\x98\x80 \xff"), "\xf0\x9f\x98\x80 \\xff");
     // A backslash is doubled, so that an escape in the output can only have come from us.
     EXPECT_EQ(printable("a\\x1b"), "a\\\\x1b");
 }

@@ -8,8 +8,10 @@
 namespace drt {
 
 // `text` with every byte a terminal would act on rather than show escaped as \xNN: the C0 controls
-// (newline and tab too, so that a message stays one line), DEL, and the C1 controls as UTF-8
-// encodes them (U+0080..U+009F, which some terminals take as escape sequences); backslash as \\.
+// (newline and tab too, so that a message stays one line), DEL, the C1 controls as UTF-8 encodes
+// them (U+0080..U+009F, which some terminals take as escape sequences), and every byte that is
+// not part of a well-formed UTF-8 character (a raw 0x9b is CSI to an 8-bit terminal); backslash
+// as \\.
 std::string printable(std::string_view text);
 
 // A value as the user wrote it, for messages: when longer than 24 bytes cut to its first 20 with
