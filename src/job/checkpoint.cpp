@@ -4,12 +4,10 @@
 #include <cstring>
 #include <iterator>
 #include <sstream>
-#include <string_view>
 #include <system_error>
 
 #include "drt/job/tile_codec.h"
 #include "drt/util/atomic_file.h"
-#include "drt/util/build_id.h"
 #include "drt/util/byte_order.h"
 #include "drt/util/file_reader.h"
 #include "drt/util/limits.h"
@@ -164,11 +162,7 @@ RenderIdentity identify_render(std::span<const fs::path> files, const RenderSett
                                const std::optional<AdaptiveSampling>& adaptive, std::uint64_t tiles,
                                std::span<const Aov> aovs) {
     RenderIdentity id;
-    // The build too: the version number alone does not change with every commit that changes
-    // what a render computes.
-    id.version = std::string_view(DRT_BUILD_ID).empty()
-                     ? std::string(DRT_VERSION)
-                     : std::string(DRT_VERSION) + " (" + DRT_BUILD_ID + ")";
+    id.version = DRT_VERSION;
     for (const fs::path& f : files) {
         try {
             id.files.push_back({f.string(), hash_bytes(read_all(f))});
