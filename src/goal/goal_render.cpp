@@ -387,6 +387,12 @@ int total_samples(const std::vector<GoalRound>& rounds) {
     return total;
 }
 
+int most_pixel_samples(const std::vector<GoalRound>& rounds) {
+    int most = 0;
+    for (const GoalRound& r : rounds) most += r.full() ? r.spp : r.top_up() ? 2 * r.spp : 0;
+    return most;
+}
+
 std::optional<Prediction> predict(const std::vector<GoalRound>& rounds, double target,
                                   int max_samples, double steepest) {
     // The image's estimate so far; none before the first full round.
@@ -420,8 +426,7 @@ std::optional<Prediction> predict(const std::vector<GoalRound>& rounds, double t
         slope = std::clamp(std::log(*b.error / *(*a)->error) / std::log(double(b.spp) / (*a)->spp),
                            steepest, -0.25);
     }
-    const double total = total_samples(rounds);
-    const double left = max_samples - total;
+    const double left = max_samples - most_pixel_samples(rounds);
     if ((now && *now <= target) || left < kMinRound) return Prediction{0, 0};
     // Rounds weighted by the inverse of their estimated variance combine to 1 / c^2, the sum of
     // 1 / e^2 over the rounds: the next reaches the goal with the error `wanted`.
@@ -441,7 +446,7 @@ std::optional<Prediction> predict(const std::vector<GoalRound>& rounds, double t
 NextRound next_round(const std::vector<GoalRound>& rounds, double target, int max_samples) {
     const GoalRound& last = rounds.back();
     const int total = total_samples(rounds);
-    const int left = max_samples - total;
+    const int left = max_samples - most_pixel_samples(rounds);
     if ((last.combined && *last.combined <= target) || left < kMinRound) return {};
     // An image whose rounds give no estimate (too few pixels to calibrate, radiance past the
     // floats) cannot be judged against the target: more samples would only be guesses.
@@ -626,10 +631,12 @@ class GoalRender {
         const NextRound n = next_round(out_.rounds, *goal_.target_error, goal_.max_samples);
         NextPlan next{n.final && goal_.stop_before_final ? 0 : n.spp, {}, {}, 0};
         if (next.spp == 0 || !n.final || !combination_) return next;
-        const int total = total_samples(out_.rounds);
         const auto last = std::find_if(out_.rounds.rbegin(), out_.rounds.rend(),
                                        [](const GoalRound& r) { return r.full(); });
-        const int count = std::min(last->spp, (goal_.max_samples - total) / 2);
+        // A pixel may be in every top-up: together they keep it within the maximum.
+        const int count =
+            std::min(last->spp, (goal_.max_samples - most_pixel_samples(out_.rounds)) / 2);
+        if (count < kMinRound) return next;
         // The first top-up of the last round's count also rescales the estimate outside it
         // (Combination), from spot checks picked with the seed the top-up renders with.
         const bool first =

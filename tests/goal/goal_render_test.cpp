@@ -177,6 +177,20 @@ TEST(NextRound, APilotATwelfthOfAPredictionFurtherAway) {
     EXPECT_EQ(next_round({pilot, {32, 1, std::nullopt, std::nullopt}}, 0.01, 65536).spp, 0);
 }
 
+// --spp bounds every pixel: one in a top-up has had twice its count more than the full rounds,
+// so what is left for the next round counts the top-ups too.
+TEST(NextRound, TopUpsCountTowardsTheMaximumOfAPixel) {
+    const GoalRound full{32, 1, 0.02, 0.02};
+    GoalRound top{16, 1, 0.01, 0.015};
+    top.kind = RoundKind::kTopUp;
+    EXPECT_EQ(total_samples({full, top}), 32);
+    EXPECT_EQ(most_pixel_samples({full, top}), 64);
+    EXPECT_EQ(next_round({full, top}, 0.001, 64).spp, 0);
+    const NextRound n = next_round({full, top}, 0.001, 80);
+    EXPECT_GE(n.spp, 2);
+    EXPECT_LE(n.spp, 16);
+}
+
 TEST(NextRound, AtLeastATenthOfTheSamplesSoFarAndTwo) {
     // Eight rounds of 25 samples at 0.02829 combine to 0.010002, just over 0.01: one more round of
     // 25 * (wanted(0.01, 0.010002) / 0.02829)^(-4/3) = 12.02 samples would do, raised to a tenth

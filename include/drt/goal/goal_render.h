@@ -102,6 +102,9 @@ double round_weight(const std::optional<double>& error, int spp);
 
 // The samples per pixel of all full rounds together: the image's.
 int total_samples(const std::vector<GoalRound>& rounds);
+// The most samples a pixel can have had: the full rounds', and twice each top-up's, should it
+// be in them all. The maximum (--spp) bounds this, so that no pixel passes it.
+int most_pixel_samples(const std::vector<GoalRound>& rounds);
 
 // Samples per pixel and time a render needs to reach an error, extrapolated from rounds.
 struct Prediction {
