@@ -300,18 +300,13 @@ Color PathIntegrator::next_event(const Vec3& point, const Vec3& geometric, const
             continue;
         }
         const Occluders occluders = emitter_occluders(plan_.emitters, bvh_, i, rays, origin, time);
-        std::array<std::optional<EmitterSample>, kChunk> emitter_samples;
         Color emitter_sum;
-        for (int first = 0; first < rays; first += kChunk) {
-            const auto n = static_cast<std::size_t>(std::min(kChunk, rays - first));
-            sampler_.get_2d_for_rays(s, dimension, rays, first, std::span(points).first(n));
-            plan_.emitters.sample(i, point, std::span<const Vec2>(points).first(n), time,
-                                  std::span(emitter_samples).first(n));
-            for (std::size_t j = 0; j < n; ++j) {
-                emitter_sum += emitter_ray(i, emitter_samples[j], origin, leaving, geometric,
-                                           shading, time, diffuse_pick, occluders, counts);
-            }
-        }
+        for_each_emitter_sample(plan_.emitters, sampler_, s, dimension, i, rays, point, time,
+                                [&](const std::optional<EmitterSample>& drawn) {
+                                    emitter_sum +=
+                                        emitter_ray(i, drawn, origin, leaving, geometric, shading,
+                                                    time, diffuse_pick, occluders, counts);
+                                });
         sum += emitter_sum / rays;
     }
     if (plan_.shared_rays > 0) {

@@ -4,13 +4,17 @@
 // surface with the footprint a camera ray has.
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <optional>
+#include <span>
 
 #include "drt/accel/bvh.h"
 #include "drt/accel/occluders.h"
 #include "drt/geometry/object.h"
 #include "drt/render/pixel_integrator.h"
+#include "drt/sampling/sampler.h"
 #include "drt/scene/camera.h"
 #include "drt/scene/emitters.h"
 #include "drt/util/math.h"
@@ -60,6 +64,26 @@ std::optional<ReachingEmitter> reach_emitter(const Emitters& emitters, const Bvh
 // when `rays` of them are worth it (occluders.h), else everything.
 Occluders emitter_occluders(const Emitters& emitters, const Bvh& bvh, std::size_t emitter, int rays,
                             const Vec3& origin, double time);
+
+// Hands `each` the next-event samples of a shading point's `rays` rays to `emitter` from
+// `point`, in ray order: their unit-square points from the sampler's `dimension` as
+// get_2d_for_ray draws them, and the samples drawn a chunk at a time, so that what a set shares
+// (its key, a sphere's cone) is worked out once. The same numbers as drawn one by one.
+template <class Each>
+void for_each_emitter_sample(const Emitters& emitters, const Sampler& sampler, const PixelSample& s,
+                             std::uint32_t dimension, std::size_t emitter, int rays,
+                             const Vec3& point, double time, Each&& each) {
+    constexpr int kChunk = 16;
+    std::array<Vec2, kChunk> points;
+    std::array<std::optional<EmitterSample>, kChunk> drawn;
+    for (int first = 0; first < rays; first += kChunk) {
+        const auto n = static_cast<std::size_t>(std::min(kChunk, rays - first));
+        sampler.get_2d_for_rays(s, dimension, rays, first, std::span(points).first(n));
+        emitters.sample(emitter, point, std::span<const Vec2>(points).first(n), time,
+                        std::span(drawn).first(n));
+        for (std::size_t j = 0; j < n; ++j) each(drawn[j]);
+    }
+}
 
 // A direction about `ideal` whose angle from it is Rayleigh-distributed with scale sigma, i.e.
 // a 2-D normal distribution of standard deviation sigma (radians) on the tangent plane.
