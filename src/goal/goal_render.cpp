@@ -449,10 +449,9 @@ NextRound next_round(const std::vector<GoalRound>& rounds, double target, int ma
     const int left = max_samples - most_pixel_samples(rounds);
     if ((last.combined && *last.combined <= target) || left < kMinRound) return {};
     // An image whose rounds give no estimate (too few pixels to calibrate, radiance past the
-    // floats) cannot be judged against the target: more samples would only be guesses.
-    const bool image = std::any_of(rounds.begin(), rounds.end(),
-                                   [](const GoalRound& r) { return r.full() || r.top_up(); });
-    if (image && !last.combined) return {};
+    // floats) cannot be judged against the target: more samples would only be guesses. (Pilots
+    // come first, so a last round that is no pilot is the image's.)
+    if (last.kind != RoundKind::kPilot && !last.combined) return {};
     // After a round meant as the last that missed, no slope steeper than -1/2: the errors' curves
     // flatten with samples (a pattern's gain over independent samples shrinks), so the slope
     // that led there was too steep.
