@@ -1,3 +1,4 @@
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -472,20 +473,17 @@ SceneFiles files_of(const std::string& scene, const std::string& output,
     return f;
 }
 
-// Whether two paths name one file: the same path once absolute and normal, or, where both
-// exist, the same file by another name (a link).
-bool same_file(const fs::path& a, const fs::path& b) {
-    std::error_code ec;
-    if (fs::exists(a, ec) && fs::exists(b, ec)) {
-        const bool same = fs::equivalent(a, b, ec);
-        if (!ec) return same;
+// What names one file, worked out once per path: its device and inode where it exists (so any
+// link to it has the same key), else its path made absolute and normal, with the symbolic links
+// of the part that exists resolved.
+std::string file_key(const fs::path& path) {
+    struct stat info {};
+    if (::stat(path.c_str(), &info) == 0) {
+        return std::to_string(info.st_dev) + ":" + std::to_string(info.st_ino);
     }
-    const auto normal = [](const fs::path& p) {
-        std::error_code error;
-        const fs::path canonical = fs::weakly_canonical(fs::absolute(p, error), error);
-        return error ? fs::absolute(p).lexically_normal() : canonical;
-    };
-    return normal(a) == normal(b);
+    std::error_code error;
+    const fs::path canonical = fs::weakly_canonical(fs::absolute(path, error), error);
+    return (error ? fs::absolute(path).lexically_normal() : canonical).string();
 }
 
 // Two of the files a command writes that are one file, which would destroy each other (a
@@ -497,29 +495,34 @@ std::optional<std::string> clashing_files(const std::vector<std::string>& scenes
     struct Written {
         std::string what;  // what writes it, for the message
         fs::path file;
-        std::string scene;        // whose image or checkpoint it is, if a scene's
-        bool checkpoint = false;  // a scene's checkpoint, not its image
+        std::string key;        // file_key(file)
+        std::string scene_key;  // file_key of the scene whose image or checkpoint it is, if any
+        bool checkpoint;        // a scene's checkpoint, not its image
     };
     std::vector<Written> files;
     for (const std::string& scene : scenes) {
         const SceneFiles f = files_of(scene, output, job.checkpoint, batch);
         const std::string of = batch ? " of " + printable(scene) : "";
+        const std::string scene_key = file_key(scene);
         files.push_back({std::string(batch || output.empty() ? "the image" : "-o") + of, f.image,
-                         scene, false});
+                         file_key(f.image), scene_key, false});
         if (f.checkpoint) {
             files.push_back({std::string(batch ? "the checkpoint" : "--checkpoint") + of,
-                             *f.checkpoint, scene, true});
+                             *f.checkpoint, file_key(*f.checkpoint), scene_key, true});
         }
     }
-    if (!job.error_image.empty()) files.push_back({"--error-image", job.error_image, "", false});
-    if (!stats.empty() && stats != "-") files.push_back({"--stats", stats, "", false});
+    if (!job.error_image.empty()) {
+        files.push_back({"--error-image", job.error_image, file_key(job.error_image), "", false});
+    }
+    if (!stats.empty() && stats != "-") {
+        files.push_back({"--stats", stats, file_key(stats), "", false});
+    }
     for (std::size_t i = 0; i < files.size(); ++i) {
         for (std::size_t j = i + 1; j < files.size(); ++j) {
             const Written &a = files[i], &b = files[j];
-            if (!same_file(a.file, b.file)) continue;
-            const bool one_scene_twice = !a.scene.empty() && !b.scene.empty() &&
-                                         a.checkpoint == b.checkpoint &&
-                                         same_file(a.scene, b.scene);
+            if (a.key != b.key) continue;
+            const bool one_scene_twice =
+                !a.scene_key.empty() && a.scene_key == b.scene_key && a.checkpoint == b.checkpoint;
             if (one_scene_twice) continue;
             return a.what + " and " + b.what + " are one file, " + printable(b.file.string()) +
                    ": one would destroy the other";
