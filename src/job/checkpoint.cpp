@@ -294,6 +294,24 @@ Checkpoint decode_checkpoint(std::span<const unsigned char> bytes, std::span<con
     return c;
 }
 
+const TileBuffer& tile_to_render_again(std::span<const TileBuffer> tiles) {
+    const TileBuffer* chosen = &tiles.front();
+    for (const TileBuffer& t : tiles) {
+        const std::uint64_t rays = t.rays.total(), most = chosen->rays.total();
+        if (rays > most || (rays == most && t.tile.index < chosen->tile.index)) chosen = &t;
+    }
+    return *chosen;
+}
+
+void check_rendered_alike(const fs::path& file, const TileBuffer& kept, const TileBuffer& again,
+                          DiffuseCount diffuse, std::size_t aov_channels) {
+    if (encode_tile(kept, diffuse, aov_channels) != encode_tile(again, diffuse, aov_channels)) {
+        fail_another_render(file, "a drt that renders this scene differently (tile " +
+                                      std::to_string(kept.tile.index) +
+                                      ", rendered again, differs)");
+    }
+}
+
 std::optional<Checkpoint> read_checkpoint(const fs::path& file, const RenderIdentity& expected,
                                           std::span<const Tile> grid) {
     std::error_code ec;

@@ -34,6 +34,33 @@ class StopAfter final : public TileSink {
     std::stop_source stop_;
 };
 
+// Keeps the one tile rendered again to check a checkpoint.
+class KeptTile final : public TileSink {
+  public:
+    void add(TileBuffer buffer) override { tile = std::move(buffer); }
+    std::optional<TileBuffer> tile;
+};
+
+// Renders one of the resumed tiles again (tile_to_render_again) and throws CheckpointError
+// unless it comes back with every bit: a checkpoint of the same scene and options written by a
+// build of drt that renders them otherwise would end in an image of two renderers' tiles. A stop
+// requested meanwhile leaves the check to the next run, which resumes the same tiles.
+void check_resumed_tiles(const RenderContext& context, const RenderRequest& request,
+                         std::span<const TileBuffer> resumed, const RenderJobOptions& options) {
+    if (resumed.empty()) return;
+    const TileBuffer& kept = tile_to_render_again(resumed);
+    TileQueue queue({kept.tile});
+    KeptTile again;
+    RenderOptions run;
+    run.threads = options.threads;
+    run.stop = options.stop;
+    render_tiles(context, request, queue, again, run);
+    if (!again.tile) return;
+    check_rendered_alike(*options.checkpoint, kept, *again.tile,
+                         diffuse_count_for(context.scene().settings),
+                         aov_channel_count(request.aovs));
+}
+
 using Clock = std::chrono::steady_clock;
 
 double seconds_between(Clock::time_point from, Clock::time_point to) {
@@ -64,7 +91,10 @@ void open_checkpoint(const RenderContext& context, const RenderRequest& request,
             }
             std::optional<Checkpoint> resumed =
                 read_checkpoint(*options.checkpoint, id, context.tiles());
-            if (resumed) resumed_tiles = resumed->tiles.size();
+            if (resumed) {
+                check_resumed_tiles(context, request, resumed->tiles, options);
+                resumed_tiles = resumed->tiles.size();
+            }
             kept.emplace(*image, *options.checkpoint, id, options.checkpoint_interval,
                          resumed ? std::move(resumed->tiles) : std::vector<TileBuffer>{});
         } catch (const CheckpointError& e) {

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <thread>
@@ -391,6 +392,56 @@ TEST_F(TempDir, APathRenderStoppedAndResumedGivesThePlainRendersBitsAndDiffuseRa
     EXPECT_EQ(r.render.stats.rays.diffuse, reference.stats.rays.diffuse);
     EXPECT_EQ(r.render.stats.rays.shadow, reference.stats.rays.shadow);
     EXPECT_EQ(r.render.stats.rays.total(), reference.stats.rays.total());
+}
+
+// A checkpoint of the same scene and options from a build of drt that renders them differently
+// (made here by moving one value of one tile by a float step, the checksum made anew) is refused
+// and left as it is: before resuming, the tile that took the most rays is rendered again and must
+// come back with every bit. Put back, the checkpoint resumes.
+TEST_F(TempDir, ACheckpointOfABuildThatRendersDifferentlyIsRefusedAndLeftAsItIs) {
+    const Scene scene = small_scene();
+    const RenderRequest request = RenderRequest::whole_image(scene.settings);
+    RenderJobOptions options;
+    options.threads = 1;
+    options.checkpoint = dir_ / "c.ckpt";
+    options.scene_files = {kEffects};
+    options.stop_after_tiles = 3;  // of 6
+    ASSERT_FALSE(run_render_job(scene, request, options).complete());
+    const fs::path file = *options.checkpoint;
+    const std::string written = read_bytes(file);
+    const std::vector<Tile> grid = tile_grid(scene.settings.width, scene.settings.height);
+    Checkpoint c = decode_checkpoint(std::vector<unsigned char>(written.begin(), written.end()),
+                                     grid, file, DiffuseCount::kOmitted);
+    ASSERT_EQ(c.tiles.size(), 3u);
+    const std::size_t checked = tile_to_render_again(c.tiles).tile.index;
+    TileBuffer* changed = nullptr;
+    for (TileBuffer& t : c.tiles) {
+        if (t.tile.index == checked) changed = &t;
+    }
+    for (const TileBuffer& t : c.tiles) EXPECT_LE(t.rays.total(), changed->rays.total());
+    float& value = changed->pixels.rgb[7];
+    value = std::nextafter(value, 2 * value + 1);
+    replace_file(file, encode_checkpoint(c.identity, c.tiles));
+    const std::string foreign = read_bytes(file);
+    options.stop_after_tiles.reset();
+    try {
+        run_render_job(scene, request, options);
+        ADD_FAILURE() << "resumed";
+    } catch (const CheckpointError& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  file.string() +
+                      ": checkpoint of another render: made by a drt that renders "
+                      "this scene differently (tile " +
+                      std::to_string(checked) +
+                      ", rendered again, differs); not resumed and nothing written (delete it "
+                      "or name another --checkpoint file)");
+    }
+    EXPECT_EQ(read_bytes(file), foreign);
+    replace_file(file, std::vector<unsigned char>(written.begin(), written.end()));
+    const RenderJobResult r = run_render_job(scene, request, options);
+    EXPECT_TRUE(r.complete());
+    EXPECT_EQ(r.resumed, 3u);
+    EXPECT_EQ(r.render.image.rgb, plain(scene, std::nullopt).image.rgb);
 }
 
 TEST_F(TempDir, ACausticRenderStoppedAndResumedGivesThePlainRendersBits) {

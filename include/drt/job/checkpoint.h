@@ -90,6 +90,17 @@ std::optional<Checkpoint> read_checkpoint(const std::filesystem::path& file,
                                           const RenderIdentity& expected,
                                           std::span<const Tile> grid);
 
+// The resumed tile to render again before resuming, so that a checkpoint written by a build of
+// drt that renders the scene otherwise is caught (the identity's version does not change with
+// every build): the one that took the most rays, which exercises the most of the renderer (the
+// lowest index among equals). `tiles` must not be empty.
+const TileBuffer& tile_to_render_again(std::span<const TileBuffer> tiles);
+
+// Throws CheckpointError (naming `file`) unless `again`, `kept` rendered again by this build, has
+// every bit and count of it.
+void check_rendered_alike(const std::filesystem::path& file, const TileBuffer& kept,
+                          const TileBuffer& again, DiffuseCount diffuse, std::size_t aov_channels);
+
 // Passes finished tiles on to another sink and keeps them, writing the checkpoint file
 // atomically whenever `interval` has passed since the last write (as a tile arrives), and on
 // request. Only a requested write reports failure: a periodic one is simply tried again.
