@@ -10,6 +10,7 @@
 
 #include "drt/io/image.h"
 #include "drt/job/checkpoint.h"
+#include "drt/job/render_job.h"
 #include "drt/sampling/sampler.h"
 #include "drt/scene/scene_loader.h"
 #include "drt/util/atomic_file.h"
@@ -162,7 +163,8 @@ int report_failure(const std::exception& error, const std::string& command,
         err << command << ": " << error.what() << "\n";
     } else if (dynamic_cast<const CheckpointError*>(&error)) {
         err << command << ": " << printable(error.what()) << "\n";
-    } else if (dynamic_cast<const LimitError*>(&error)) {
+    } else if (dynamic_cast<const LimitError*>(&error) ||
+               dynamic_cast<const ProcessesDisagree*>(&error)) {
         err << about << error.what() << "\n";
     } else if (dynamic_cast<const std::bad_alloc*>(&error)) {
         err << about << "out of memory\n";

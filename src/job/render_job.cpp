@@ -1,15 +1,18 @@
 #include "drt/job/render_job.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <stdexcept>
 #include <string>
 
 #include "drt/job/checkpoint.h"
+#include "drt/job/tile_codec.h"
 #include "drt/render/render_context.h"
 #include "drt/render/tile.h"
 #include "drt/util/atomic_file.h"
 #include "drt/util/limits.h"
+#include "drt/util/rng.h"
 
 namespace drt {
 
@@ -34,7 +37,7 @@ class StopAfter final : public TileSink {
     std::stop_source stop_;
 };
 
-// Keeps the one tile rendered again to check a checkpoint.
+// Keeps the one tile a check renders (of a checkpoint, of MPI processes).
 class KeptTile final : public TileSink {
   public:
     void add(TileBuffer buffer) override { tile = std::move(buffer); }
@@ -59,6 +62,52 @@ void check_resumed_tiles(const RenderContext& context, const RenderRequest& requ
     check_rendered_alike(*options.checkpoint, kept, *again.tile,
                          diffuse_count_for(context.scene().settings),
                          aov_channel_count(request.aovs));
+}
+
+// Under MPI, every process renders the 4 x 4 pixels at the middle of the image and fingerprints
+// them with the files it read and its settings; the render goes ahead only where every process's
+// fingerprint is the leader's. A few pixels catch another build (which the version number does
+// not tell apart), the files another edit, the settings another command line.
+void check_processes_agree(const RenderContext& context, const RenderRequest& request,
+                           const RenderJobOptions& options) {
+    const MpiJob* mpi = options.mpi;
+    if (mpi == nullptr || mpi->size() == 1) return;
+    const RenderSettings& settings = context.scene().settings;
+    constexpr int kProbe = 4;
+    const int x0 = std::max(0, settings.width / 2 - kProbe / 2);
+    const int y0 = std::max(0, settings.height / 2 - kProbe / 2);
+    TileQueue queue({Tile{0, x0, y0, std::min(settings.width, x0 + kProbe),
+                          std::min(settings.height, y0 + kProbe)}});
+    KeptTile probe;
+    RenderOptions run;
+    run.threads = options.threads;
+    render_tiles(context, request, queue, probe, run);
+    std::uint64_t fingerprint =
+        probe.tile ? hash_bytes(encode_tile(*probe.tile, diffuse_count_for(settings),
+                                            aov_channel_count(request.aovs)))
+                   : 0;
+    try {
+        const RenderIdentity id =
+            identify_render(options.scene_files, settings, request.applied_adaptive(),
+                            context.tiles().size(), request.aovs);
+        const auto* version = reinterpret_cast<const unsigned char*>(id.version.data());
+        fingerprint = hash_of(fingerprint, id.options, hash_bytes({version, id.version.size()}));
+        for (const FileFingerprint& f : id.files) fingerprint = hash_combine(fingerprint, f.hash);
+    } catch (const CheckpointError&) {
+        fingerprint = hash_combine(fingerprint, 0);  // a file gone since: unlike any other
+    }
+    const std::vector<std::uint32_t> leaders = mpi->broadcast(
+        {static_cast<std::uint32_t>(fingerprint), static_cast<std::uint32_t>(fingerprint >> 32)});
+    const bool differs = leaders.size() != 2 ||
+                         leaders[0] != static_cast<std::uint32_t>(fingerprint) ||
+                         leaders[1] != static_cast<std::uint32_t>(fingerprint >> 32);
+    if (const int rank = mpi->highest(differs ? mpi->rank() : 0); rank != 0) {
+        throw ProcessesDisagree(
+            "process " + std::to_string(rank) + " of the " + std::to_string(mpi->size()) +
+            " renders this scene differently from process 0 (another scene or OBJ file, other "
+            "options or another build of drt there); every process must read the same files "
+            "with the same command and drt");
+    }
 }
 
 using Clock = std::chrono::steady_clock;
@@ -139,6 +188,7 @@ RenderJobResult run_job(const RenderContext& context, const RenderRequest& asked
     RenderRequest request = asked;
     request.estimate_error = request.estimate_error || options.checkpoint.has_value();
     context.check(request);
+    check_processes_agree(context, request, options);
     const Scene& scene = context.scene();
     const bool leader = options.mpi == nullptr || options.mpi->leader();
     RenderJobResult out;

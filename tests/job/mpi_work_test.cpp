@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "drt/io/image.h"
+#include "drt/util/atomic_file.h"
 #include "run_drt.h"
 #include "temp_folder.h"
 
@@ -364,6 +365,45 @@ TEST_F(MpiCli, ForeignCheckpointIsRefusedByEveryProcessWithOneMessage) {
     EXPECT_NE(r.err.find("checkpoint of another render"), std::string::npos) << r.err;
     EXPECT_EQ(bytes("c.ckpt"), before);
     EXPECT_FALSE(fs::exists(dir_ / "out.pfm"));
+}
+
+// Processes that would render different images, because one was given another seed or read
+// another scene file (here with a brighter light), are refused before any tile is rendered:
+// exit 2, one message naming the process, no image. The same command on both renders.
+TEST_F(MpiCli, ProcessesThatWouldRenderDifferentlyAreRefusedBeforeRendering) {
+    const auto two_commands = [&](const std::vector<std::string>& first,
+                                  const std::vector<std::string>& second) {
+        std::vector<std::string> argv{
+            "mpirun", "--allow-run-as-root", "--oversubscribe", "-n", "1", DRT_BINARY};
+        argv.insert(argv.end(), first.begin(), first.end());
+        argv.insert(argv.end(), {":", "-n", "1", DRT_BINARY});
+        argv.insert(argv.end(), second.begin(), second.end());
+        return run_process(argv, dir_);
+    };
+    const std::string scene = read_bytes(kMotion);
+    const std::string bright = "Ir=\"1.0\"";
+    const std::size_t light = scene.find(bright);
+    ASSERT_NE(light, std::string::npos);
+    replace_file(dir_ / "a.xml", scene);
+    replace_file(dir_ / "b.xml",
+                 scene.substr(0, light) + "Ir=\"1.5\"" + scene.substr(light + bright.size()));
+    const std::string refused =
+        ": process 1 of the 2 renders this scene differently from process 0 (another scene or "
+        "OBJ file, other options or another build of drt there); every process must read the "
+        "same files with the same command and drt\n";
+    for (const auto& second : {small("a.xml", "out.pfm", {"--spp", "2", "--seed", "1"}),
+                               small("b.xml", "out.pfm", {"--spp", "2"})}) {
+        const Outcome r = two_commands(small("a.xml", "out.pfm", {"--spp", "2"}), second);
+        EXPECT_EQ(r.status, 2) << r.err;
+        // Once, from the leader (mpirun adds its own report of the exit status).
+        EXPECT_NE(r.err.find("drt: a.xml" + refused), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find(refused), r.err.rfind(refused)) << r.err;
+        EXPECT_FALSE(fs::exists(dir_ / "out.pfm"));
+    }
+    const Outcome same = two_commands(small("a.xml", "out.pfm", {"--spp", "2"}),
+                                      small("a.xml", "out.pfm", {"--spp", "2"}));
+    EXPECT_EQ(same.status, 0) << same.err;
+    EXPECT_TRUE(fs::exists(dir_ / "out.pfm"));
 }
 
 // The process ids of `parent`'s children running drt with OMPI_COMM_WORLD_RANK=`rank`.

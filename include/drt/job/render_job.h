@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <stdexcept>
 #include <stop_token>
 #include <string>
 #include <vector>
@@ -20,6 +21,14 @@
 #include "drt/scene/scene.h"
 
 namespace drt {
+
+// The processes of an MPI job would render the image differently: each reads the scene and its
+// files itself and runs its own drt, and one that read other bytes, took other options or is
+// another build would put tiles of another image into this one. The message names a process.
+class ProcessesDisagree : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
 
 // How a job runs; what it renders is its RenderRequest.
 struct RenderJobOptions {
@@ -53,9 +62,10 @@ struct RenderJobResult {
 };
 
 // Sets `scene` up and renders `request` (collective under MPI). Throws CheckpointError (on every
-// process) when the checkpoint cannot be used; when stopped, the checkpoint has been written
-// before this returns, or checkpoint_failure says why not. The caller writes the image, and removes
-// the checkpoint once the image is safely written.
+// process) when the checkpoint cannot be used, ProcessesDisagree (on every process) when the
+// processes of an MPI job do not render alike (checked first, on a few pixels and the files); when
+// stopped, the checkpoint has been written before this returns, or checkpoint_failure says why not.
+// The caller writes the image, and removes the checkpoint once the image is safely written.
 RenderJobResult run_render_job(const Scene& scene, const RenderRequest& request,
                                const RenderJobOptions& options);
 
