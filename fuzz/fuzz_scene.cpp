@@ -1,7 +1,9 @@
 // libFuzzer target: a scene file as deep as the renderer goes. Whatever loads is rendered, cut
 // down to a few pixels and samples so that each input takes milliseconds: loading is fuzzed in
-// full, rendering for every effect the scene calls for.
+// full, rendering for every effect the scene calls for. A NaN pixel is a defect wherever it comes
+// from; an infinite one may be the scene's own radiance past the float range.
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
@@ -33,6 +35,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     s.max_depth = std::min(s.max_depth, 6);
     drt::RenderOptions options;
     options.threads = 1;
-    drt::render(loaded.scene, options);
+    const drt::RenderResult r = drt::render(loaded.scene, options);
+    for (const float v : r.image.rgb) {
+        if (std::isnan(v)) __builtin_trap();
+    }
     return 0;
 }
