@@ -19,6 +19,7 @@
 #include "cli_render.h"
 #include "drt/goal/goal_render.h"
 #include "drt/io/image.h"
+#include "drt/job/checkpoint.h"
 #include "drt/job/mpi_work.h"
 #include "drt/job/render_job.h"
 #include "drt/render/aov.h"
@@ -277,9 +278,16 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
     outcome.scene = scene_path;
     const std::string name = printable(scene_path);
     std::optional<LoadedScene> loaded;
+    std::vector<fs::path> scene_files;
+    std::uint64_t scene_files_hash = 0;
     int status = guarded(name, err, [&] {
         format_for_path(output);  // refuse an unknown extension before spending time rendering
         loaded.emplace(load_scene(scene_path));
+        scene_files = {scene_path};
+        scene_files.insert(scene_files.end(), loaded->files_read.begin(), loaded->files_read.end());
+        // Once a scene, where a failure is still agreed on: the processes compare it before
+        // each render (run_render_job).
+        if (job.mpi && job.mpi->size() > 1) scene_files_hash = hash_files(scene_files);
         for (const std::string& w : loaded->warnings) err << w << "\n";
         job.overrides.apply(loaded->scene.settings);
         // The error estimate measures noise; a photon-mapped caustic is also biased at every
@@ -323,9 +331,8 @@ SceneOutcome render_one(const std::string& scene_path, const fs::path& output,
     RenderJobOptions options;
     options.threads = job.threads;
     options.checkpoint = checkpoint;
-    options.scene_files = {scene_path};
-    options.scene_files.insert(options.scene_files.end(), loaded->files_read.begin(),
-                               loaded->files_read.end());
+    options.scene_files = std::move(scene_files);
+    options.scene_files_hash = scene_files_hash;
     options.checkpoint_interval = std::chrono::duration<double>(job.checkpoint_seconds);
     options.stop_after_tiles = job.stop_after_tiles;
     options.costly_first = !job.grid_order;

@@ -158,6 +158,12 @@ std::uint64_t hash_bytes(std::span<const unsigned char> bytes) {
     return hash_combine(h, tail);
 }
 
+std::uint64_t hash_files(std::span<const fs::path> files) {
+    std::uint64_t h = files.size();
+    for (const fs::path& f : files) h = hash_combine(h, hash_bytes(read_all(f)));
+    return h;
+}
+
 RenderIdentity identify_render(std::span<const fs::path> files, const RenderSettings& settings,
                                const std::optional<AdaptiveSampling>& adaptive, std::uint64_t tiles,
                                std::span<const Aov> aovs) {

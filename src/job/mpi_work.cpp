@@ -502,6 +502,10 @@ std::vector<std::uint32_t> MpiJob::broadcast(std::vector<std::uint32_t> values) 
     return values;
 }
 
+int MpiJob::threads_for(int requested) const {
+    return requested > 0 ? requested : share_of_machine(local_size());
+}
+
 int MpiJob::highest(int value) const {
     return transport_->highest(value);
 }
@@ -510,7 +514,7 @@ MpiShare MpiJob::render_tiles(const RenderContext& context, const RenderRequest&
                               std::vector<Tile> todo, TileSink& sink,
                               const RenderOptions& options) const {
     RenderOptions run = options;
-    if (run.threads <= 0) run.threads = share_of_machine(local_size());
+    run.threads = threads_for(run.threads);
     if (leader()) {
         LeaderQueue queue(std::move(todo), options.stop);
         MpiShare share;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <exception>
 #include <stdexcept>
 #include <string>
 
@@ -55,7 +56,7 @@ void check_resumed_tiles(const RenderContext& context, const RenderRequest& requ
     TileQueue queue({kept.tile});
     KeptTile again;
     RenderOptions run;
-    run.threads = options.threads;
+    run.threads = options.mpi ? options.mpi->threads_for(options.threads) : options.threads;
     run.stop = options.stop;
     render_tiles(context, request, queue, again, run);
     if (!again.tile) return;
@@ -65,45 +66,59 @@ void check_resumed_tiles(const RenderContext& context, const RenderRequest& requ
 }
 
 // Under MPI, every process renders the 4 x 4 pixels at the middle of the image and fingerprints
-// them with the files it read and its settings; the render goes ahead only where every process's
-// fingerprint is the leader's. A few pixels catch another build (which the version number does
-// not tell apart), the files another edit, the settings another command line.
+// them with its settings, its version and the hash of the files it read; the render goes ahead
+// only where every process's fingerprint is the leader's. The pixels catch another build that
+// renders them otherwise (the version number does not tell builds apart), the files a stale
+// copy, the settings another command line. A sample, not a proof: a build that differs only
+// elsewhere in the image passes. Every process takes part in both collectives whatever happens
+// to it, so that a process that fails here (out of memory, say) cannot leave the others waiting.
 void check_processes_agree(const RenderContext& context, const RenderRequest& request,
                            const RenderJobOptions& options) {
     const MpiJob* mpi = options.mpi;
     if (mpi == nullptr || mpi->size() == 1) return;
-    const RenderSettings& settings = context.scene().settings;
-    constexpr int kProbe = 4;
-    const int x0 = std::max(0, settings.width / 2 - kProbe / 2);
-    const int y0 = std::max(0, settings.height / 2 - kProbe / 2);
-    TileQueue queue({Tile{0, x0, y0, std::min(settings.width, x0 + kProbe),
-                          std::min(settings.height, y0 + kProbe)}});
-    KeptTile probe;
-    RenderOptions run;
-    run.threads = options.threads;
-    render_tiles(context, request, queue, probe, run);
-    std::uint64_t fingerprint =
-        probe.tile ? hash_bytes(encode_tile(*probe.tile, diffuse_count_for(settings),
-                                            aov_channel_count(request.aovs)))
-                   : 0;
+    std::uint64_t fingerprint = 0;
+    std::exception_ptr failure;
     try {
-        const RenderIdentity id =
-            identify_render(options.scene_files, settings, request.applied_adaptive(),
-                            context.tiles().size(), request.aovs);
+        const RenderSettings& settings = context.scene().settings;
+        constexpr int kProbe = 4;
+        const int x0 = std::max(0, settings.width / 2 - kProbe / 2);
+        const int y0 = std::max(0, settings.height / 2 - kProbe / 2);
+        TileQueue queue({Tile{0, x0, y0, std::min(settings.width, x0 + kProbe),
+                              std::min(settings.height, y0 + kProbe)}});
+        KeptTile probe;
+        RenderOptions run;
+        run.threads = mpi->threads_for(options.threads);
+        run.stop = options.stop;
+        render_tiles(context, request, queue, probe, run);
+        if (probe.tile) {
+            fingerprint = hash_bytes(encode_tile(*probe.tile, diffuse_count_for(settings),
+                                                 aov_channel_count(request.aovs)));
+        }
+        const RenderIdentity id = identify_render({}, settings, request.applied_adaptive(),
+                                                  context.tiles().size(), request.aovs);
         const auto* version = reinterpret_cast<const unsigned char*>(id.version.data());
-        fingerprint = hash_of(fingerprint, id.options, hash_bytes({version, id.version.size()}));
-        for (const FileFingerprint& f : id.files) fingerprint = hash_combine(fingerprint, f.hash);
-    } catch (const CheckpointError&) {
-        fingerprint = hash_combine(fingerprint, 0);  // a file gone since: unlike any other
+        fingerprint = hash_of(fingerprint, id.options, hash_bytes({version, id.version.size()}),
+                              options.scene_files_hash);
+    } catch (...) {
+        failure = std::current_exception();
     }
     const std::vector<std::uint32_t> leaders = mpi->broadcast(
         {static_cast<std::uint32_t>(fingerprint), static_cast<std::uint32_t>(fingerprint >> 32)});
     const bool differs = leaders.size() != 2 ||
                          leaders[0] != static_cast<std::uint32_t>(fingerprint) ||
                          leaders[1] != static_cast<std::uint32_t>(fingerprint >> 32);
-    if (const int rank = mpi->highest(differs ? mpi->rank() : 0); rank != 0) {
+    // Agreed by all: a failed process (size + its rank) outranks one that differs (its rank).
+    const int size = mpi->size(), rank = mpi->rank();
+    const int worst = mpi->highest(failure ? size + rank : differs ? rank : 0);
+    if (failure) std::rethrow_exception(failure);
+    if (worst >= size) {
+        throw std::runtime_error("process " + std::to_string(worst - size) + " of the " +
+                                 std::to_string(size) +
+                                 " failed before rendering (only process 0's messages are shown)");
+    }
+    if (worst != 0) {
         throw ProcessesDisagree(
-            "process " + std::to_string(rank) + " of the " + std::to_string(mpi->size()) +
+            "process " + std::to_string(worst) + " of the " + std::to_string(size) +
             " renders this scene differently from process 0 (another scene or OBJ file, other "
             "options or another build of drt there); every process must read the same files "
             "with the same command and drt");
@@ -128,6 +143,7 @@ void open_checkpoint(const RenderContext& context, const RenderRequest& request,
         throw std::invalid_argument("a checkpoint of a request other than the scene's image");
     }
     std::string refused;
+    std::exception_ptr failure;  // anything else that went wrong on the leader
     if (leader) {
         try {
             const RenderIdentity id =
@@ -148,10 +164,14 @@ void open_checkpoint(const RenderContext& context, const RenderRequest& request,
                          resumed ? std::move(resumed->tiles) : std::vector<TileBuffer>{});
         } catch (const CheckpointError& e) {
             refused = e.what();
+        } catch (...) {
+            failure = std::current_exception();
         }
     }
-    const bool refuse =
-        options.mpi ? options.mpi->broadcast(refused.empty() ? 0 : 1) != 0 : !refused.empty();
+    // Every process takes part in the broadcast, whatever happened on the leader.
+    const bool ok = refused.empty() && !failure;
+    const bool refuse = options.mpi ? options.mpi->broadcast(ok ? 0 : 1) != 0 : !ok;
+    if (failure) std::rethrow_exception(failure);
     if (refuse) throw CheckpointError(leader ? refused : "the leader refused the checkpoint");
 }
 

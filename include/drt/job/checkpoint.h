@@ -59,6 +59,9 @@ struct RenderIdentity {
 // A 64-bit hash of bytes, for fingerprints and for the checksum that catches a damaged file.
 std::uint64_t hash_bytes(std::span<const unsigned char> bytes);
 
+// One hash of the bytes of all `files`, in order; throws CheckpointError when one cannot be read.
+std::uint64_t hash_files(std::span<const std::filesystem::path> files);
+
 // `files` are the scene file and whatever it reads; throws CheckpointError when one cannot be
 // read. Options that only change how the work is done (threads, processes, output, progress)
 // are not part of the identity.

@@ -65,6 +65,9 @@ class MpiJob {
     // Processes of this job on this machine, this one included: they share its cores.
     int local_size() const { return transport_->local_size(); }
 
+    // The worker threads this process runs for `requested` (0: its share of the machine's cores).
+    int threads_for(int requested) const;
+
     // The leader's value, on every process (collective).
     int broadcast(int value) const;
     // The leader's values, on every process (collective): the leader sends them to each.

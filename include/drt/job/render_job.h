@@ -41,6 +41,9 @@ struct RenderJobOptions {
     // samples and seed, whose error a checkpoint always estimates (it keeps the estimate's sums).
     std::optional<std::filesystem::path> checkpoint;
     std::vector<std::filesystem::path> scene_files;
+    // Under MPI, hash_files(scene_files) as this process read them, worked out once a scene by
+    // the caller: every process's must be the leader's (a process with a stale copy differs).
+    std::uint64_t scene_files_hash = 0;
     std::chrono::duration<double> checkpoint_interval = std::chrono::seconds(30);
     // For tests: stop as a signal would once this many tiles are done, resumed ones included.
     std::optional<std::size_t> stop_after_tiles;
