@@ -77,6 +77,7 @@ void check_processes_agree(const RenderContext& context, const RenderRequest& re
     const MpiJob* mpi = options.mpi;
     if (mpi == nullptr || mpi->size() == 1) return;
     std::uint64_t fingerprint = 0;
+    bool stopped = false;  // before the probe was done: the render that follows stops too
     std::exception_ptr failure;
     try {
         const RenderSettings& settings = context.scene().settings;
@@ -90,6 +91,7 @@ void check_processes_agree(const RenderContext& context, const RenderRequest& re
         run.threads = mpi->threads_for(options.threads);
         run.stop = options.stop;
         render_tiles(context, request, queue, probe, run);
+        stopped = !probe.tile;
         if (probe.tile) {
             fingerprint = hash_bytes(encode_tile(*probe.tile, diffuse_count_for(settings),
                                                  aov_channel_count(request.aovs)));
@@ -102,11 +104,14 @@ void check_processes_agree(const RenderContext& context, const RenderRequest& re
     } catch (...) {
         failure = std::current_exception();
     }
-    const std::vector<std::uint32_t> leaders = mpi->broadcast(
-        {static_cast<std::uint32_t>(fingerprint), static_cast<std::uint32_t>(fingerprint >> 32)});
-    const bool differs = leaders.size() != 2 ||
-                         leaders[0] != static_cast<std::uint32_t>(fingerprint) ||
-                         leaders[1] != static_cast<std::uint32_t>(fingerprint >> 32);
+    // A probe cut short by a stop is no evidence either way.
+    const std::vector<std::uint32_t> leaders =
+        mpi->broadcast({static_cast<std::uint32_t>(fingerprint),
+                        static_cast<std::uint32_t>(fingerprint >> 32), stopped ? 1u : 0u});
+    const bool differs =
+        leaders.size() != 3 || (!stopped && leaders[2] == 0 &&
+                                (leaders[0] != static_cast<std::uint32_t>(fingerprint) ||
+                                 leaders[1] != static_cast<std::uint32_t>(fingerprint >> 32)));
     // Agreed by all: a failed process (size + its rank) outranks one that differs (its rank).
     const int size = mpi->size(), rank = mpi->rank();
     const int worst = mpi->highest(failure ? size + rank : differs ? rank : 0);
