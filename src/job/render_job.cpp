@@ -45,6 +45,19 @@ class KeptTile final : public TileSink {
     std::optional<TileBuffer> tile;
 };
 
+// `tile` of `request` on this process's workers, for a check; nothing when a stop cut it short.
+std::optional<TileBuffer> render_for_check(const RenderContext& context,
+                                           const RenderRequest& request, const Tile& tile,
+                                           const RenderJobOptions& options) {
+    TileQueue queue({tile});
+    KeptTile kept;
+    RenderOptions run;
+    run.threads = options.mpi ? options.mpi->threads_for(options.threads) : options.threads;
+    run.stop = options.stop;
+    render_tiles(context, request, queue, kept, run);
+    return std::move(kept.tile);
+}
+
 // Renders one of the resumed tiles again (tile_to_render_again) and throws CheckpointError
 // unless it comes back with every bit: a checkpoint of the same scene and options written by a
 // build of drt that renders them otherwise would end in an image of two renderers' tiles. A stop
@@ -53,14 +66,9 @@ void check_resumed_tiles(const RenderContext& context, const RenderRequest& requ
                          std::span<const TileBuffer> resumed, const RenderJobOptions& options) {
     if (resumed.empty()) return;
     const TileBuffer& kept = tile_to_render_again(resumed);
-    TileQueue queue({kept.tile});
-    KeptTile again;
-    RenderOptions run;
-    run.threads = options.mpi ? options.mpi->threads_for(options.threads) : options.threads;
-    run.stop = options.stop;
-    render_tiles(context, request, queue, again, run);
-    if (!again.tile) return;
-    check_rendered_alike(*options.checkpoint, kept, *again.tile,
+    const std::optional<TileBuffer> again = render_for_check(context, request, kept.tile, options);
+    if (!again) return;
+    check_rendered_alike(*options.checkpoint, kept, *again,
                          diffuse_count_for(context.scene().settings),
                          aov_channel_count(request.aovs));
 }
@@ -84,17 +92,15 @@ void check_processes_agree(const RenderContext& context, const RenderRequest& re
         constexpr int kProbe = 4;
         const int x0 = std::max(0, settings.width / 2 - kProbe / 2);
         const int y0 = std::max(0, settings.height / 2 - kProbe / 2);
-        TileQueue queue({Tile{0, x0, y0, std::min(settings.width, x0 + kProbe),
-                              std::min(settings.height, y0 + kProbe)}});
-        KeptTile probe;
-        RenderOptions run;
-        run.threads = mpi->threads_for(options.threads);
-        run.stop = options.stop;
-        render_tiles(context, request, queue, probe, run);
-        stopped = !probe.tile;
-        if (probe.tile) {
-            fingerprint = hash_bytes(encode_tile(*probe.tile, diffuse_count_for(settings),
-                                                 aov_channel_count(request.aovs)));
+        const std::optional<TileBuffer> probe =
+            render_for_check(context, request,
+                             Tile{0, x0, y0, std::min(settings.width, x0 + kProbe),
+                                  std::min(settings.height, y0 + kProbe)},
+                             options);
+        stopped = !probe;
+        if (probe) {
+            fingerprint = hash_bytes(
+                encode_tile(*probe, diffuse_count_for(settings), aov_channel_count(request.aovs)));
         }
         const RenderIdentity id = identify_render({}, settings, request.applied_adaptive(),
                                                   context.tiles().size(), request.aovs);
