@@ -11,27 +11,51 @@ namespace drt {
 
 namespace {
 
-// Splits `total` rays among lights in proportion to `powers`, at least one each, by largest
-// remainder so the counts add up to `total` exactly.
+// Splits `total` rays among lights in proportion to `powers` (Cook), at least one each: a light
+// whose share is under one ray gets one, and the others share the rest in proportion, again
+// and again until every share left is at least one. Whole rays by largest remainder (the more
+// powerful light first among equal remainders), so that the counts add up to `total` exactly
+// and a share that is a whole number is given exactly (1:3 of 8 rays is 2 and 6).
 std::vector<int> share_rays(int total, const std::vector<double>& powers) {
     const std::size_t n = powers.size();
-    std::vector<int> counts(n, 1);
-    const double sum = std::accumulate(powers.begin(), powers.end(), 0.0);
-    const int spare = total - static_cast<int>(n);
-    if (spare <= 0) return counts;
-    std::vector<double> remainders(n);
-    int given = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        const double ideal = sum > 0 ? spare * powers[i] / sum : double(spare) / n;
-        counts[i] += static_cast<int>(std::floor(ideal));
-        given += static_cast<int>(std::floor(ideal));
-        remainders[i] = ideal - std::floor(ideal);
+    std::vector<int> counts(n, 0);
+    if (total <= static_cast<int>(n)) return std::vector<int>(n, 1);
+    // Unfixed lights' shares of `left` rays; every power 0 shares equally.
+    int left = total;
+    const auto shares = [&] {
+        double sum = 0;
+        std::size_t unfixed = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            if (counts[i] == 0) sum += powers[i], ++unfixed;
+        }
+        std::vector<double> share(n, 0.0);
+        for (std::size_t i = 0; i < n; ++i) {
+            if (counts[i] == 0)
+                share[i] =
+                    sum > 0 && std::isfinite(sum) ? left * powers[i] / sum : double(left) / unfixed;
+        }
+        return share;
+    };
+    std::vector<double> share = shares();
+    for (bool fixed_one = true; fixed_one;) {
+        fixed_one = false;
+        for (std::size_t i = 0; i < n; ++i) {
+            if (counts[i] == 0 && share[i] < 1) counts[i] = 1, --left, fixed_one = true;
+        }
+        if (fixed_one) share = shares();
     }
-    std::vector<std::size_t> order(n);
-    std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(),
-                     [&](std::size_t a, std::size_t b) { return remainders[a] > remainders[b]; });
-    for (std::size_t k = 0; given < spare; ++k, ++given) ++counts[order[k % n]];
+    std::vector<std::size_t> order;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (counts[i] != 0) continue;
+        counts[i] = static_cast<int>(std::floor(share[i]));
+        left -= counts[i];
+        share[i] -= counts[i];
+        order.push_back(i);
+    }
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        return share[a] != share[b] ? share[a] > share[b] : powers[a] > powers[b];
+    });
+    for (std::size_t k = 0; left > 0; ++k, --left) ++counts[order[k % order.size()]];
     return counts;
 }
 

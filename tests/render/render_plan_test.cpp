@@ -52,6 +52,34 @@ TEST(RenderPlan, AreaLightsShareShadowRaysInProportionToPower) {
     EXPECT_EQ(r.stats.rays.shadow, 16u * 9u);
 }
 
+TEST(RenderPlan, AShareThatIsAWholeNumberOfRaysIsGivenExactly) {
+    // Powers 1 and 3: a quarter and three quarters of the rays, whichever light comes first.
+    for (const int rays : {8, 16, 100}) {
+        for (const bool weak_first : {true, false}) {
+            Scene scene = floor_scene(4, 4);
+            scene.settings.shadow_rays = rays;
+            add_sphere_light(scene, {0, 100, 0}, 5, weak_first ? Color{1, 1, 1} : Color{3, 3, 3});
+            add_sphere_light(scene, {10, 100, 0}, 5, weak_first ? Color{3, 3, 3} : Color{1, 1, 1});
+            const std::vector<int> quarter{rays / 4, 3 * rays / 4};
+            const std::vector<int> expected =
+                weak_first ? quarter : std::vector<int>{quarter[1], quarter[0]};
+            EXPECT_EQ(plan_render(scene).shadow_rays, expected) << rays << " rays";
+        }
+    }
+}
+
+TEST(RenderPlan, LightsUnderOneRayGetOneAndTheOthersShareTheRestInProportion) {
+    // Shares 3.33, 1 and 0.67 of 5 rays: the last gets one, which leaves the middle one
+    // 4 × 3/13 = 0.92, so it gets one too, and the first the remaining three (where one ray
+    // each and the two left by power would give 2, 2 and 1).
+    Scene scene = floor_scene(4, 4);
+    scene.settings.shadow_rays = 5;
+    add_sphere_light(scene, {0, 100, 0}, 5, {10, 10, 10});
+    add_sphere_light(scene, {10, 100, 0}, 5, {3, 3, 3});
+    add_sphere_light(scene, {20, 100, 0}, 5, {2, 2, 2});
+    EXPECT_EQ(plan_render(scene).shadow_rays, (std::vector<int>{3, 1, 1}));
+}
+
 TEST(RenderPlan, EveryAreaLightGetsAtLeastOneRay) {
     Scene scene = floor_scene(4, 4);
     scene.settings.shadow_rays = 3;
