@@ -1,6 +1,7 @@
 #include "drt/accel/triangle_mesh.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -77,13 +78,31 @@ void TriangleMesh::take(const ObjMesh& obj, const MeshTransform& transform, bool
                                       [](std::uint32_t n) { return n != ObjMesh::kNoNormal; });
     std::vector<std::uint32_t> vertex_position;  // vertex -> position
     std::vector<std::uint32_t> vertex_normal;    // vertex -> file normal or kNoNormal
-    std::unordered_map<std::uint64_t, std::uint32_t> vertex_of;
-    const auto vertex = [&](std::uint32_t p, std::uint32_t n) {
+    std::vector<bool> vertex_turned;             // vertex -> its file normal is negated
+    std::array<std::unordered_map<std::uint64_t, std::uint32_t>, 2> vertex_of;  // [turned]
+    const auto vertex = [&](std::uint32_t p, std::uint32_t n, bool turned) {
         if (!file_normals) return p;
-        const auto [it, added] = vertex_of.try_emplace(
+        turned = turned && n != ObjMesh::kNoNormal;
+        const auto [it, added] = vertex_of[turned].try_emplace(
             (std::uint64_t{p} << 32) | n, static_cast<std::uint32_t>(vertex_position.size()));
-        if (added) vertex_position.push_back(p), vertex_normal.push_back(n);
+        if (added) {
+            vertex_position.push_back(p), vertex_normal.push_back(n);
+            vertex_turned.push_back(turned);
+        }
         return it->second;
+    };
+    // Whether a face's file normals point, summed, against its winding: the winding tells the
+    // outside (as it does for a transparent material), and a shading normal on the other side
+    // would leave the face lit by no light. Such a face's corners take their normals negated,
+    // so that a file wound clockwise with outward normals shades as its mirror image would.
+    // (Rotation and a positive scale keep the sign of the product.)
+    const auto against_winding = [&](const std::uint32_t* p, const std::uint32_t* n) {
+        Vec3 sum;
+        for (int k = 0; k < 3; ++k) {
+            if (n[k] != ObjMesh::kNoNormal) sum += obj.normals[n[k]];
+        }
+        const Vec3 &a = obj.positions[p[0]], &b = obj.positions[p[1]], &c = obj.positions[p[2]];
+        return dot(sum, cross(b - a, c - a)) < 0;
     };
     if (!file_normals) {
         vertex_position.resize(placed.size());
@@ -116,7 +135,9 @@ void TriangleMesh::take(const ObjMesh& obj, const MeshTransform& transform, bool
             continue;
         }
         const std::uint32_t* n = &obj.normal_indices[c];
-        triangles_.push_back({vertex(p[0], n[0]), vertex(p[1], n[1]), vertex(p[2], n[2])});
+        const bool turned = file_normals && against_winding(p, n);
+        triangles_.push_back(
+            {vertex(p[0], n[0], turned), vertex(p[1], n[1], turned), vertex(p[2], n[2], turned)});
         if (parted) parts_.push_back(obj.triangle_materials[c / 3]);
         if (!obj.texcoord_indices.empty()) {
             std::array<float, 6> uv{};
@@ -154,10 +175,12 @@ void TriangleMesh::take(const ObjMesh& obj, const MeshTransform& transform, bool
             computed[p[2]] += n * corner_angle(c, a, b);
         }
         normals_.resize(positions_.size());
+        if (std::ranges::find(vertex_turned, true) != vertex_turned.end()) turned_ = vertex_turned;
         for (std::size_t v = 0; v < normals_.size(); ++v) {
             Vec3 n = computed[vertex_position[v]];
             if (file_normals && vertex_normal[v] != ObjMesh::kNoNormal) {
-                const Vec3 given = rotation(obj.normals[vertex_normal[v]]);
+                const Vec3 file_normal = obj.normals[vertex_normal[v]];
+                const Vec3 given = rotation(vertex_turned[v] ? -file_normal : file_normal);
                 if (max_abs_component(given) > 0) n = given;
             }
             // A normal that cancelled out stays zero; shading falls back to the face's.
@@ -197,7 +220,8 @@ Vec3 TriangleMesh::lifted(std::uint32_t triangle, const Barycentrics& b) const {
     const double weights[3] = {b.b0, b.b1, b.b2};
     const Vec3 vertices[3] = {p0, p1, p2};
     for (int k = 0; k < 3; ++k) {
-        const Vec3 n = to_vec3(normals_[t[k]]);
+        const Vec3 n =
+            turned_.empty() || !turned_[t[k]] ? to_vec3(normals_[t[k]]) : -to_vec3(normals_[t[k]]);
         lift -= n * (weights[k] * std::min(0.0, dot(p - vertices[k], n)));
     }
     return p + lift;
@@ -205,7 +229,7 @@ Vec3 TriangleMesh::lifted(std::uint32_t triangle, const Barycentrics& b) const {
 
 std::size_t TriangleMesh::bytes() const {
     return positions_.capacity() * sizeof(Float3) + normals_.capacity() * sizeof(Float3) +
-           triangles_.capacity() * sizeof(triangles_[0]) +
+           turned_.capacity() / 8 + triangles_.capacity() * sizeof(triangles_[0]) +
            texcoords_.capacity() * sizeof(texcoords_[0]) + corners_.capacity() * sizeof(float) +
            face_normals_.capacity() * sizeof(Vec3) + parts_.capacity() * sizeof(parts_[0]) +
            tree_.memory() + sizeof(*this);

@@ -124,6 +124,30 @@ TEST(TriangleMesh, UsesTheFilesNormalsRotatedWithTheMesh) {
     EXPECT_TRUE(near(mesh.geometric_normal(0), {0, -1, 0}, 0));
 }
 
+// A face wound clockwise with outward file normals: the winding decides the outside, and the
+// face's normals are turned to it, where a vertex normal shared with a face that agrees with
+// them is kept as written.
+TEST(TriangleMesh, FileNormalsAgainstTheWindingAreTurnedToItsSide) {
+    ObjMesh obj;
+    obj.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+    obj.normals = {{0, 0, -1}, {0.6, 0, -0.8}};
+    // The first (winding +z) has normals towards −z; the second (winding −z) agrees with them.
+    // Corner b of both is position 1, whose file normal is the second.
+    obj.position_indices = {0, 1, 2, 3, 1, 2};
+    obj.normal_indices = {0, 1, 0, 0, 1, 0};
+    const TriangleMesh mesh(obj, {}, true);
+    ASSERT_EQ(mesh.triangle_count(), 2u);
+    for (std::uint32_t t = 0; t < 2; ++t) {
+        const Vec3 g = mesh.geometric_normal(t);
+        const bool turned = g.z > 0;
+        const Vec3 at_b = turned ? Vec3{-0.6, 0, 0.8} : Vec3{0.6, 0, -0.8};
+        const Vec3 elsewhere = turned ? Vec3{0, 0, 1} : Vec3{0, 0, -1};
+        EXPECT_TRUE(near(mesh.shading_normal(t, {0, 1, 0}), at_b, 1e-7)) << t;
+        EXPECT_TRUE(near(mesh.shading_normal(t, {1, 0, 0}), elsewhere, 1e-7)) << t;
+        EXPECT_GT(dot(mesh.shading_normal(t, {0.2, 0.3, 0.5}), g), 0) << t;
+    }
+}
+
 // The hierarchy finds what testing every triangle finds: the same nearest triangle and t.
 TEST(TriangleMesh, NearestHitIsThatOfTestingEveryTriangle) {
     // A sphere and a shell of random triangles inside it.

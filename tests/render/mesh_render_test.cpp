@@ -191,6 +191,40 @@ TEST(MeshRender, ACoarseSmoothIcosphereHasNoBlackFacetsAtTheTerminator) {
     EXPECT_EQ(black, 0);
 }
 
+// A file's outward vertex normals on faces wound clockwise (inward by the winding): the faces'
+// normals are turned to their winding's side, so the ball shades as the same ball wound
+// counter-clockwise does. Before, the normals' side decided which lights were above, and the
+// ball was black.
+TEST(MeshRender, OutwardFileNormalsOnInwardWoundFacesShadeAsOnOutwardOnes) {
+    const auto lit = [](bool clockwise) {
+        const testing::TestMesh ball = testing::icosphere(2, 1.5);
+        ObjMesh obj = testing::obj_of(ball);
+        for (const Vec3& p : ball.vertices) obj.normals.push_back(p);  // radial, outward
+        obj.normal_indices = obj.position_indices;
+        if (clockwise) {
+            for (std::size_t c = 0; c < obj.position_indices.size(); c += 3) {
+                std::swap(obj.position_indices[c + 1], obj.position_indices[c + 2]);
+                std::swap(obj.normal_indices[c + 1], obj.normal_indices[c + 2]);
+            }
+        }
+        Scene scene = testing::blank_scene(32, 32, 1);
+        scene.view = LookAt{{0, 0, -10}, {0, 0, 0}, {0, 1, 0}, 20};
+        const Material& m = add_material(scene, testing::grey_lambert(1.0));
+        scene.objects.push_back(
+            std::make_unique<Mesh>(std::make_shared<const TriangleMesh>(obj, MeshTransform{}, true),
+                                   std::vector<Vec3>{{}}, m));
+        scene.lights.push_back(std::make_unique<PointLight>(Vec3{-5, 5, -10}, Color{1, 1, 1}));
+        return rendered_image(scene);
+    };
+    const Image outward = lit(false), inward = lit(true);
+    double sum = 0;
+    for (const float v : outward.rgb) sum += v;
+    EXPECT_GT(sum / static_cast<double>(outward.rgb.size()), 0.1);  // the ball is lit
+    const Difference d = difference(outward, inward);
+    EXPECT_LT(d.mean, 1e-6);
+    EXPECT_LT(d.max, 1e-4);  // measured: the same bits
+}
+
 // Rays from all around a coarse smooth icosphere (80 triangles), and from inside it, meet facets
 // where the interpolated normal leans far from the facet's: about the shading normal alone, a
 // grazing ray's mirror direction would often enter the ball and its refracted direction often

@@ -140,6 +140,9 @@ class TriangleMesh {
     Vec3 origin_;
     std::vector<Float3> positions_;  // relative to origin_
     std::vector<Float3> normals_;    // per vertex, unit; empty for a flat mesh
+    // Per vertex, whether its normal is the file's turned to its faces' winding (take()); empty
+    // when none is. The lift towards the curved surface (lifted) keeps the file's side.
+    std::vector<bool> turned_;
     std::vector<std::array<std::uint32_t, 3>> triangles_;  // in leaf order
     // Per triangle, its corners' (u, v) in single precision; empty when the file has no `vt`.
     std::vector<std::array<float, 6>> texcoords_;
