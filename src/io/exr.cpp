@@ -147,7 +147,7 @@ DataWindow data_window(const Imf::InputFile& in, const Fail& fail) {
     const long long w = static_cast<long long>(box.max.x) - box.min.x + 1;
     const long long h = static_cast<long long>(box.max.y) - box.min.y + 1;
     if (w <= 0 || h <= 0) throw fail("bad OpenEXR data window");
-    if (past_image_limits(w, h)) throw fail(too_many_pixels(w, h));
+    if (past_image_limits(w, h)) throw fail(image_limit_message(w, h));
     return {box, w, h};
 }
 

@@ -108,7 +108,7 @@ struct Layout {
         if (!size) return std::nullopt;
         const auto [w, h] = *size;
         if (w <= 0 || h <= 0) return std::nullopt;  // OpenEXR's to refuse
-        if (past_image_limits(w, h)) return too_many_pixels(w, h);
+        if (past_image_limits(w, h)) return image_limit_message(w, h);
         const std::uint64_t pixels =
             tile ? tile->first * tile->second
                  : static_cast<std::uint64_t>(w) * lines_per_block(compression);

@@ -115,7 +115,7 @@ Image decode_8bit(const Bytes& data, ImageFormat format, const fs::path& path) {
     // The size from the header, before stb allocates for it.
     if (stbi_info_from_memory(data.data(), static_cast<int>(data.size()), &w, &h, &channels) &&
         std::uint64_t(w) * std::uint64_t(h) > kMaxPixels) {
-        fail(path, too_many_pixels(w, h));
+        fail(path, image_limit_message(w, h));
     }
     const std::unique_ptr<stbi_uc, decltype(&stbi_image_free)> pixels(
         stbi_load_from_memory(data.data(), static_cast<int>(data.size()), &w, &h, &channels, 3),
@@ -178,7 +178,7 @@ Image decode_pfm(const Bytes& data, const fs::path& path) {
     const int h = header.number<int>("height");
     const double scale = header.number<double>("scale");
     if (w <= 0 || h <= 0 || w > kMaxSide || h > kMaxSide) fail(path, "bad PFM size");
-    if (std::uint64_t(w) * std::uint64_t(h) > kMaxPixels) fail(path, too_many_pixels(w, h));
+    if (std::uint64_t(w) * std::uint64_t(h) > kMaxPixels) fail(path, image_limit_message(w, h));
     if (scale == 0 || !std::isfinite(scale)) fail(path, "bad PFM scale");
     const std::size_t start = header.data_start();
 

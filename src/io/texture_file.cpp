@@ -135,7 +135,7 @@ Image decode_stb(const Bytes& data, const fs::path& path, Kind kind, TextureEnco
     if (data.size() > static_cast<std::size_t>(INT32_MAX)) fail(path, "file too large");
     const int size = static_cast<int>(data.size());
     const auto check_size = [&](std::uint64_t w, std::uint64_t h) {
-        if (past_image_limits(w, h)) fail(path, too_many_pixels(w, h));
+        if (past_image_limits(w, h)) fail(path, image_limit_message(w, h));
     };
     // stb refuses a huge PNG from its header too, but says only "too large": read the size.
     if (kind == Kind::kPng && data.size() >= 24) {

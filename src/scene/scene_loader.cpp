@@ -270,7 +270,7 @@ class SceneReader {
         in.check(s.height > 0, "Height", "positive");
         in.check(s.height <= kMaxImageSide, "Height", at_most(kMaxImageSide));
         if (std::uint64_t(s.width) * std::uint64_t(s.height) > kMaxPixels) {
-            in.fail(too_many_pixels(s.width, s.height) + " (docs/scene-format.md#limits)");
+            in.fail(image_limit_message(s.width, s.height) + " (docs/scene-format.md#limits)");
         }
         in.warn_unknown();
         warn_children(e);

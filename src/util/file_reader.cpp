@@ -42,7 +42,10 @@ struct Descriptor {
 
 template <class Container>
 Container read_whole(const fs::path& path, std::uint64_t max_bytes, FileKinds kinds) {
-    const Descriptor file{::open(path.c_str(), O_RDONLY | O_CLOEXEC)};
+    // Opened without waiting where only a regular file will do, so that a named pipe with no
+    // writer is refused below instead of blocking the open (a regular file ignores the flag).
+    const int wait = kinds == FileKinds::regular_only ? O_NONBLOCK : 0;
+    const Descriptor file{::open(path.c_str(), O_RDONLY | O_CLOEXEC | wait)};
     if (file.fd < 0) throw FileReadError(FileProblem::cannot_open, errno);
     struct stat info {};
     if (::fstat(file.fd, &info) != 0) throw FileReadError(FileProblem::cannot_open, errno);

@@ -5,9 +5,13 @@
 
 namespace drt {
 
-std::string too_many_pixels(std::uint64_t width, std::uint64_t height) {
-    return "image of " + std::to_string(width) + "x" + std::to_string(height) +
-           " pixels exceeds the limit of " + std::to_string(kMaxPixels) + " pixels";
+std::string image_limit_message(std::uint64_t width, std::uint64_t height) {
+    const std::string image =
+        "image of " + std::to_string(width) + "x" + std::to_string(height) + " pixels";
+    if (width > kMaxImageSide || height > kMaxImageSide) {
+        return image + " exceeds the limit of " + std::to_string(kMaxImageSide) + " pixels a side";
+    }
+    return image + " exceeds the limit of " + std::to_string(kMaxPixels) + " pixels";
 }
 
 int worker_threads(int threads) {

@@ -139,10 +139,13 @@ Bytes header(std::uint32_t w, std::uint32_t h, int channels, unsigned char compr
 }
 
 // The reader allocates a decoded block from the header alone: the data window is held to the
-// pixel limit, and a block (DWAB's 256 lines, or a tile) to 512 MiB, before it does.
+// image limits (pixels and sides), and a block (DWAB's 256 lines, or a tile) to 512 MiB, before it
+// does.
 TEST(ExrHeader, TheDataWindowAndTheBlocksAreHeldToTheLimitsBeforeOpenExrAllocates) {
     EXPECT_EQ(exr_header_problem(header(5963780, 3, 3, 3)),
-              "image of 5963780x3 pixels exceeds the limit of 134217728 pixels");
+              "image of 5963780x3 pixels exceeds the limit of 65536 pixels a side");
+    EXPECT_EQ(exr_header_problem(header(16385, 8192, 3, 3)),
+              "image of 16385x8192 pixels exceeds the limit of 134217728 pixels");
     EXPECT_EQ(exr_header_problem(header(65536, 2048, 3, 3)), std::nullopt);
     // 65536 x 256 pixels of 8 floats is 512 MiB exactly; of 9, past it.
     EXPECT_EQ(exr_header_problem(header(65536, 2048, 8, 9)), std::nullopt);

@@ -1,6 +1,7 @@
 #include "drt/io/image.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <bit>
@@ -376,6 +377,10 @@ TEST_F(ImageFileTest, FoldersDevicesAndPipesNamedLikeImagesAreRefused) {
     fs::create_symlink("loop.png", file("loop.png"));
     EXPECT_EQ(read_error(file("loop.png")),
               file("loop.png").string() + ": cannot open file: Too many levels of symbolic links");
+    // A named pipe nothing writes to: refused at once, where opening it to read would wait for
+    // a writer forever.
+    ASSERT_EQ(::mkfifo(file("pipe.pfm").c_str(), 0600), 0);
+    EXPECT_EQ(read_error(file("pipe.pfm")), file("pipe.pfm").string() + ": not a regular file");
 }
 
 TEST_F(ImageFileTest, ControlCharactersInFileNamesAreEscaped) {

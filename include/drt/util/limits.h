@@ -35,9 +35,10 @@ inline constexpr int kMaxImageSide = 65536;
 constexpr bool past_image_limits(std::uint64_t width, std::uint64_t height) {
     return width > kMaxImageSide || height > kMaxImageSide || width * height > kMaxPixels;
 }
-// What every reader of an image's size says when it is past a limit: "image of WxH pixels
-// exceeds the limit of 134217728 pixels".
-std::string too_many_pixels(std::uint64_t width, std::uint64_t height);
+// What every reader of an image's size says when it is past a limit, naming the side limit
+// where a side is past it: "image of WxH pixels exceeds the limit of 134217728 pixels" (or "of
+// 65536 pixels a side").
+std::string image_limit_message(std::uint64_t width, std::uint64_t height);
 // Camera samples per pixel, and shadow or glossy rays per shading point: 2^16 each, so that a
 // pixel's sample index times a set's size stays within the samplers' 32-bit index space (and a
 // thread's per-sample memory within 36 MiB).
