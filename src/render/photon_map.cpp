@@ -60,9 +60,14 @@ double default_photon_radius(const Scene& scene) {
     // The box where caustics form: the objects that bend light and catch it. An emitter (a
     // Falloff-1 sphere light, an emitting mesh) lights the scene from wherever it is, often far
     // off, and would make the radius too wide to show any caustic; it counts only when the scene
-    // has nothing else.
-    const bool lit_objects = std::ranges::any_of(
-        scene.objects, [](const auto& object) { return !object->material().emits(); });
+    // has nothing else. Planes, unbounded, never count.
+    const auto bounded = [](const Object& object) {
+        const Shapes shapes = object.shapes();
+        return !shapes.spheres.empty() || !shapes.meshes.empty();
+    };
+    const bool lit_objects = std::ranges::any_of(scene.objects, [&](const auto& object) {
+        return !object->material().emits() && bounded(*object);
+    });
     Bounds bounds;
     for (const auto& object : scene.objects) {
         if (lit_objects && object->material().emits()) continue;

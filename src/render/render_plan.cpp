@@ -206,6 +206,8 @@ std::string describe(const Scene& scene, const RenderPlan& plan) {
             out << " (photon maps: " << s.photons->count
                 << " photons a pass, one pass a sample; first gather radius "
                 << first_photon_radius(scene) << ")";
+        } else if (s.max_depth == 0) {
+            out << " (<Photons> given, but MaxDepth 0 lets no light reflect or refract)";
         } else {
             out << " (<Photons> given, but no Falloff-1 light or emitter, reflective or "
                    "transparent surface and diffuse surface together)";

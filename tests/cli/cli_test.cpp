@@ -1275,6 +1275,11 @@ TEST_F(CliPhotons, StatsCountPhotonsAndGoalsAreRefusedWithoutAnEstimate) {
     EXPECT_NE(info.out.find("caustics: sampled (photon maps: 1000 photons a pass"),
               std::string::npos)
         << info.out;
+    const Outcome no_depth = run_drt({"info", "c.xml", "--max-depth", "0"}, dir_);
+    EXPECT_NE(no_depth.out.find("caustics: off (<Photons> given, but MaxDepth 0 lets no light "
+                                "reflect or refract)"),
+              std::string::npos)
+        << no_depth.out;
 }
 
 }  // namespace

@@ -175,6 +175,12 @@ TEST(PhotonMap, TheDefaultRadiusLeavesFarEmittersOut) {
                          R"(<Scene><Materials><Lamp ker="1"/></Materials>
       <Sphere Px="0" Py="0" Pz="0" Radius="50" Material="Lamp"/></Scene>)")),
                      std::sqrt(3.0) * 100 / 100);
+    // Planes, unbounded, are no box: beside them the emitters' box it is (it was 1).
+    EXPECT_DOUBLE_EQ(default_photon_radius(from_xml(
+                         R"(<Scene><Materials><Lamp ker="1"/><Mirror reflective="1"/></Materials>
+      <Sphere Px="0" Py="0" Pz="0" Radius="50" Material="Lamp"/>
+      <Plane Px="0" Py="-60" Pz="0" Vu="0" Vv="1" Vw="0" Material="Mirror"/></Scene>)")),
+                     std::sqrt(3.0) * 100 / 100);
 }
 
 // Transmission through the ball: the photons' power on the floor is the light the ball
