@@ -155,7 +155,8 @@ fi
 seconds_at() {
     awk -F, -v e="$2" -v tc="${3:-6}" -v ec="${4:-3}" '
         BEGIN { n = 0 }
-        NR > 1 && $NF == 1 { t[n] = $tc; r[n] = $ec; n++ }
+        NR == 1 { for (i = 1; i <= NF; i++) if ($i == "fitted") fc = i }
+        NR > 1 && $fc == 1 { t[n] = $tc; r[n] = $ec; n++ }
         END {
             for (i = 0; i + 1 < n; i++) {
                 if (r[i] >= e && e >= r[i + 1]) {
@@ -173,7 +174,8 @@ g3() { awk -v v="$1" 'BEGIN { printf "%.3g", v }'; }
 # slope FILE COLUMN: least-squares slope of log RMSE against log COLUMN over the fitted rows.
 slope() {
     awk -F, -v c="$2" 'BEGIN { n = 0 }
-        NR > 1 && $NF == 1 { x = log($c); y = log($3); n++; sx += x; sy += y; sxx += x * x; sxy += x * y }
+        NR == 1 { for (i = 1; i <= NF; i++) if ($i == "fitted") fc = i }
+        NR > 1 && $fc == 1 { x = log($c); y = log($3); n++; sx += x; sy += y; sxx += x * x; sxy += x * y }
         END { printf "%.2f", (n * sxy - sx * sy) / (n * sxx - sx * sx) }' "$1"
 }
 ratio() { awk -v a="${1#\~}" -v b="${2#\~}" 'BEGIN { printf "%.2f", a / b }'; }
