@@ -2,7 +2,8 @@
 # Draws the prediction of a goal render against what the render then took and reached, from
 # tools/goal-study.sh's CSV (docs/accuracy.md, section 6): left, the predicted seconds (drt info
 # --target-error E) against the goal render's seconds; right, the target E against the goal
-# render's true RMSE (against a 4096-spp reference) and its own estimate.
+# render's true RMSE (against a 4096-spp reference) and its own estimate. The plot places the
+# thesis scenes (test1 .. test6) side by side; rows of other scenes are left out, and said so.
 # Needs gnuplot (tools/install-deps.sh --study).
 #
 # usage: tools/goal-plot.sh CSV [PNG]   (default PNG: docs/images/accuracy-goal.png)
@@ -14,6 +15,16 @@ command -v gnuplot >/dev/null || {
     echo "goal-plot: gnuplot is missing; run tools/install-deps.sh --study" >&2
     exit 2
 }
+thesis_rows=$(mktemp)
+trap 'rm -f "$thesis_rows"' EXIT
+awk -F, 'NR == 1 || $1 ~ /^test[1-6]$/' "$csv" >"$thesis_rows"
+others=$(awk -F, 'NR > 1 && $1 !~ /^test[1-6]$/' "$csv" | wc -l)
+[ "$others" -eq 0 ] || echo "goal-plot: $others rows of other scenes left out (the plot places test1 .. test6)" >&2
+if [ "$(wc -l <"$thesis_rows")" -le 1 ]; then
+    echo "goal-plot: no rows of thesis scenes in $csv to plot" >&2
+    exit 2
+fi
+csv=$thesis_rows
 # Columns (goal-study.sh): 1 scene, 2 target, 3 predicted_spp, 4 predicted_s, 5 goal_spp,
 # 6 goal_rounds, 7 goal_s, 8 goal_render_s, 9 goal_estimated, 10 goal_true, 11 fixed_spp,
 # 12 fixed_s, 13 fixed_render_s, 14 fixed_true, 15 load.

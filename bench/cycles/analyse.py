@@ -126,6 +126,8 @@ for scene in scenes:
         c = reached["cycles"]
         for renderer in renderers[:-1]:
             d = reached[renderer]
-            ratios = [f"{x / y:.2f}x" if y > 0 else "n/a" for x, y in zip(c, d)]
+            # A time at or below 0 is a line fitted to clocks too coarse for the run (a tiny
+            # --scale): no ratio is honest then.
+            ratios = [f"{x / y:.2f}x" if x > 0 and y > 0 else "n/a" for x, y in zip(c, d)]
             print(f"      cycles / {renderer}: {ratios[0]} excluded, {ratios[1]} included, "
                   f"{ratios[2]} CPU")

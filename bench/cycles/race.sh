@@ -52,6 +52,8 @@ now() { date +%s.%N; }
 since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.3f", b - a }'; }
 
 # One render each; appends a row to runs.tsv.
+# A render no longer than its own 1-spp start-up (a tiny --scale, where the clocks' noise is the
+# whole time) counts 0 s start-up excluded, never less.
 render_drt() {  # scene name spp seed round scale sampler [shadow-rays]
     local name=drt extra=()
     [ "$7" = stratified ] || name=drt-$7
@@ -67,7 +69,7 @@ render_drt() {  # scene name spp seed round scale sampler [shadow-rays]
         --sampler "$7" "${extra[@]}" --threads "$threads" -q -o "$image"
     wall=$(since "$start")
     printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$2" "$name" "$3" "$5" "$wall" \
-        "$(awk -v w="$wall" -v s="$startup" 'BEGIN { printf "%.3f", w - s }')" \
+        "$(awk -v w="$wall" -v s="$startup" 'BEGIN { d = w - s; printf "%.3f", d > 0 ? d : 0 }')" \
         "$(awk '{ printf "%.2f", $1 + $2 }' "$out/time")" "$image" >>"$runs"
 }
 render_cycles() {  # scene name spp seed round scale
