@@ -60,29 +60,29 @@ double default_photon_radius(const Scene& scene) {
     // The box where caustics form: the objects that bend light and catch it. An emitter (a
     // Falloff-1 sphere light, an emitting mesh) lights the scene from wherever it is, often far
     // off, and would make the radius too wide to show any caustic; it counts only when the scene
-    // has nothing else. Planes, unbounded, never count.
-    const auto bounded = [](const Object& object) {
-        const Shapes shapes = object.shapes();
-        return !shapes.spheres.empty() || !shapes.meshes.empty();
-    };
-    const bool lit_objects = std::ranges::any_of(scene.objects, [&](const auto& object) {
-        return !object->material().emits() && bounded(*object);
-    });
-    Bounds bounds;
+    // has nothing else. A plane, unbounded, has an empty box here and never counts.
+    std::vector<Bounds> boxes;  // per object, at time 0
     for (const auto& object : scene.objects) {
-        if (lit_objects && object->material().emits()) continue;
+        Bounds box;
         const Shapes shapes = object->shapes();
         for (const SphereShape& s : shapes.spheres) {
             const Vec3 c = s.path->at(0);
             const Vec3 r{s.radius, s.radius, s.radius};
-            bounds.grow(c - r).grow(c + r);
+            box.grow(c - r).grow(c + r);
         }
         for (const MeshShape& m : shapes.meshes) {
-            const Bounds b = m.bounds;
-            if (b.empty()) continue;
+            if (m.bounds.empty()) continue;
             const Vec3 origin = m.path->at(0);
-            bounds.grow(origin + b.lo).grow(origin + b.hi);
+            box.grow(origin + m.bounds.lo).grow(origin + m.bounds.hi);
         }
+        boxes.push_back(box);
+    }
+    const auto emits = [&](std::size_t i) { return scene.objects[i]->material().emits(); };
+    bool lit_objects = false;
+    for (std::size_t i = 0; i < boxes.size(); ++i) lit_objects |= !emits(i) && !boxes[i].empty();
+    Bounds bounds;
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+        if (!(lit_objects && emits(i))) bounds.grow(boxes[i]);
     }
     if (bounds.empty()) return 1;
     const double diagonal = length(bounds.extent());
